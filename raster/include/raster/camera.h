@@ -1,0 +1,60 @@
+// View: everything the rasterizer needs to see a scene from one eye, and the projection focal
+// uses everywhere. Built by the app from a glTF camera, the command line or the scene bounds;
+// the accumulation reference derives sheared views from it (lens_offset, focus_distance).
+//
+// Depth convention: d is the distance along the view axis (camera space -z). The depth buffer
+// stores D = (1/n - 1/d) / (1/n - 1/f) in [0,1] (D3D-style z/w; f = inf gives D = 1 - n/d),
+// which is affine in 1/d, like the circle of confusion.
+#pragma once
+
+#include <raster/scene.h>
+
+#include <cstdint>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+namespace raster {
+
+struct View {
+    glm::vec3 eye{0.0f};
+    glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit view axis
+    glm::vec3 right{1.0f, 0.0f, 0.0f};     // unit, image +x
+    glm::vec3 up{0.0f, 1.0f, 0.0f};        // unit, image -y (pixel rows grow downwards)
+    float yfov = 0.8f;                     // vertical field of view, radians
+    uint32_t width = 800;
+    uint32_t height = 600;
+    float znear = 0.1f;
+    float zfar = 0.0f;  // 0: infinite far plane
+
+    // Off-axis shifts for the accumulation reference (Haeberli & Akeley 1990): the eye moves by
+    // lens_offset (world units along right/up) while the frustum is sheared so that the plane at
+    // focus_distance keeps its pixels; pixel_shift moves the image by a sub-pixel amount.
+    glm::vec2 lens_offset{0.0f};
+    float focus_distance = 1.0f;
+    glm::vec2 pixel_shift{0.0f};  // pixels, +x right, +y down
+};
+
+// Focal length in pixels: f_px = (H/2) / tan(yfov/2).
+float focalLengthPx(const View& view);
+
+// World -> camera space (right, up, -forward), with the eye moved by lens_offset.
+glm::mat4 viewMatrix(const View& view);
+// Camera -> clip space: the off-axis frustum described above, z_clip/w_clip = D (see top).
+glm::mat4 projectionMatrix(const View& view);
+
+// Stored depth D <-> distance d along the view axis.
+float depthFromDistance(const View& view, float d);
+float distanceFromDepth(const View& view, float stored_depth);
+
+// The view through scene.cameras[index] for an image of width x height. Non-square glTF
+// aspect ratios keep yfov (vertical fit), as glTF specifies.
+View viewFromCamera(const Camera& camera, uint32_t width, uint32_t height);
+// A view that frames the whole bounds from the +z side, looking slightly down.
+View viewFramingBounds(const Bounds& bounds, uint32_t width, uint32_t height);
+// A view from eye to target; up is made orthogonal to the view axis.
+View viewLookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float yfov, uint32_t width,
+                uint32_t height, float znear, float zfar);
+
+}  // namespace raster

@@ -1,0 +1,50 @@
+// TaskPool: a fixed set of std::thread workers, created by the caller and passed down (no
+// globals). parallelFor hands out indices from one atomic counter; which worker runs which index
+// is not deterministic, so callers write each result to a slot owned by its index.
+// threads == 0 runs everything inline on the calling thread.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace raster {
+
+class TaskPool {
+public:
+    explicit TaskPool(uint32_t threads);
+    ~TaskPool();
+    TaskPool(const TaskPool&) = delete;
+    TaskPool& operator=(const TaskPool&) = delete;
+
+    // Number of distinct `worker` values parallelFor passes (>= 1).
+    uint32_t workerCount() const { return worker_count_; }
+    uint32_t threadCount() const { return thread_count_; }
+
+    // Calls fn(index, worker) once for every index in [0, count); returns when all are done.
+    // The calling thread takes part as worker 0. Not reentrant.
+    void parallelFor(uint32_t count, const std::function<void(uint32_t, uint32_t)>& fn);
+
+private:
+    void workerLoop(uint32_t worker);
+    void drain(uint32_t worker);
+
+    uint32_t thread_count_ = 0;
+    uint32_t worker_count_ = 1;
+    std::vector<std::thread> threads_;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::condition_variable done_;
+    const std::function<void(uint32_t, uint32_t)>* job_ = nullptr;
+    uint32_t job_count_ = 0;
+    uint64_t generation_ = 0;
+    uint32_t busy_ = 0;
+    bool stop_ = false;
+    std::atomic<uint32_t> next_{0};
+};
+
+}  // namespace raster

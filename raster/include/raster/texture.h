@@ -1,0 +1,57 @@
+// Textures: decoded images with their mip chains, samplers, and filtered lookups.
+// Produced by glTF import and the built-in scene generators (owned by the Scene); sampled by the
+// tile raster. Texels are 8-bit RGBA as on a GPU; sRGB images are decoded to linear light
+// *before* filtering (a 256-entry table), and mip levels are box-filtered in linear space.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+namespace raster {
+
+enum class Wrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+enum class Filter : uint8_t { Nearest, Linear };
+enum class MipFilter : uint8_t { None, Nearest, Linear };
+
+// glTF sampler (glTF 2.0 §5.26); minification picks the filter inside and between levels.
+struct Sampler {
+    Wrap wrap_s = Wrap::Repeat;
+    Wrap wrap_t = Wrap::Repeat;
+    Filter mag = Filter::Linear;
+    Filter min = Filter::Linear;
+    MipFilter mip = MipFilter::Linear;
+};
+
+struct MipLevel {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<uint8_t> rgba8;  // width*height*4, row 0 is the top row (glTF uv (0,0))
+};
+
+struct Image {
+    std::string name;
+    bool srgb = true;              // colour channels sRGB-encoded (base colour, emissive)
+    std::vector<MipLevel> levels;  // levels[0] is the full image; buildMipChain adds the rest
+};
+
+// Replaces image.levels[1..] with the full chain down to 1x1: each texel of level i+1 is the
+// average of the (up to) 2x2 texels of level i, computed in linear light and re-encoded.
+void buildMipChain(Image& image);
+
+// The filter the CLI may force on every sampler (--texture-filter).
+enum class FilterOverride : uint8_t { Sampler, Nearest, Bilinear, Trilinear };
+
+// Linear-light RGBA at uv with the level of detail `lod` (log2 of texels per pixel; <= 0 is
+// magnification). Wrapping follows the sampler; filtering follows the sampler unless overridden.
+glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride filter,
+                      glm::vec2 uv, float lod);
+
+// sRGB transfer function, exact (IEC 61966-2-1).
+float srgbToLinear(float v);
+float linearToSrgb(float v);
+
+}  // namespace raster

@@ -1,0 +1,153 @@
+#include <raster/texture.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <glm/common.hpp>
+
+namespace raster {
+
+float srgbToLinear(float v) {
+    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+float linearToSrgb(float v) {
+    return v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+namespace {
+
+// Decoding table for 8-bit sRGB, built once (thread-safe static initialisation).
+const std::array<float, 256>& srgbTable() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i)
+            t[size_t(i)] = srgbToLinear(float(i) / 255.0f);
+        return t;
+    }();
+    return table;
+}
+
+uint8_t encode8(float v, bool srgb) {
+    const float c = std::clamp(srgb ? linearToSrgb(v) : v, 0.0f, 1.0f);
+    return uint8_t(c * 255.0f + 0.5f);
+}
+
+glm::vec4 fetch(const MipLevel& level, bool srgb, int x, int y) {
+    const uint8_t* t = &level.rgba8[(size_t(y) * level.width + size_t(x)) * 4];
+    if (srgb) {
+        const std::array<float, 256>& lut = srgbTable();
+        return {lut[t[0]], lut[t[1]], lut[t[2]], float(t[3]) * (1.0f / 255.0f)};
+    }
+    return glm::vec4(t[0], t[1], t[2], t[3]) * (1.0f / 255.0f);
+}
+
+int wrapIndex(int64_t i, int n, Wrap wrap) {
+    switch (wrap) {
+    case Wrap::Repeat:
+        return int(((i % n) + n) % n);
+    case Wrap::ClampToEdge:
+        return int(std::clamp<int64_t>(i, 0, n - 1));
+    case Wrap::MirroredRepeat: {
+        const int64_t m = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return int(m < n ? m : 2 * n - 1 - m);
+    }
+    }
+    return 0;
+}
+
+// Texel coordinate of u, clamped so huge or non-finite values cannot overflow the integer cast.
+double texelCoord(float u, uint32_t size) {
+    const double x = std::isfinite(u) ? double(u) * size - 0.5 : 0.0;
+    return std::clamp(x, -1073741824.0, 1073741824.0);
+}
+
+glm::vec4 sampleLevel(const Image& image, const MipLevel& level, const Sampler& s, Filter filter,
+                      glm::vec2 uv) {
+    const int w = int(level.width), h = int(level.height);
+    const double x = texelCoord(uv.x, level.width);
+    const double y = texelCoord(uv.y, level.height);
+    if (filter == Filter::Nearest) {
+        const int64_t ix = int64_t(std::floor(x + 0.5)), iy = int64_t(std::floor(y + 0.5));
+        return fetch(level, image.srgb, wrapIndex(ix, w, s.wrap_s), wrapIndex(iy, h, s.wrap_t));
+    }
+    const double fx = std::floor(x), fy = std::floor(y);
+    const float ax = float(x - fx), ay = float(y - fy);
+    const int x0 = wrapIndex(int64_t(fx), w, s.wrap_s), x1 = wrapIndex(int64_t(fx) + 1, w, s.wrap_s);
+    const int y0 = wrapIndex(int64_t(fy), h, s.wrap_t), y1 = wrapIndex(int64_t(fy) + 1, h, s.wrap_t);
+    const glm::vec4 top = glm::mix(fetch(level, image.srgb, x0, y0), fetch(level, image.srgb, x1, y0), ax);
+    const glm::vec4 bottom =
+        glm::mix(fetch(level, image.srgb, x0, y1), fetch(level, image.srgb, x1, y1), ax);
+    return glm::mix(top, bottom, ay);
+}
+
+}  // namespace
+
+void buildMipChain(Image& image) {
+    if (image.levels.empty())
+        return;
+    image.levels.resize(1);
+    while (image.levels.back().width > 1 || image.levels.back().height > 1) {
+        const MipLevel& src = image.levels.back();
+        MipLevel dst;
+        dst.width = std::max(1u, src.width / 2);
+        dst.height = std::max(1u, src.height / 2);
+        dst.rgba8.resize(size_t(dst.width) * dst.height * 4);
+        for (uint32_t y = 0; y < dst.height; ++y) {
+            for (uint32_t x = 0; x < dst.width; ++x) {
+                glm::vec4 sum(0.0f);
+                int n = 0;
+                for (uint32_t dy = 0; dy < 2; ++dy) {
+                    for (uint32_t dx = 0; dx < 2; ++dx) {
+                        const uint32_t sx = std::min(2 * x + dx, src.width - 1);
+                        const uint32_t sy = std::min(2 * y + dy, src.height - 1);
+                        sum += fetch(src, image.srgb, int(sx), int(sy));
+                        ++n;
+                    }
+                }
+                sum /= float(n);
+                uint8_t* t = &dst.rgba8[(size_t(y) * dst.width + x) * 4];
+                t[0] = encode8(sum.r, image.srgb);
+                t[1] = encode8(sum.g, image.srgb);
+                t[2] = encode8(sum.b, image.srgb);
+                t[3] = encode8(sum.a, false);
+            }
+        }
+        image.levels.push_back(std::move(dst));
+    }
+}
+
+glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride filter,
+                      glm::vec2 uv, float lod) {
+    if (image.levels.empty())
+        return glm::vec4(1.0f);
+    Filter mag = sampler.mag, min = sampler.min;
+    MipFilter mip = sampler.mip;
+    switch (filter) {
+    case FilterOverride::Sampler:
+        break;
+    case FilterOverride::Nearest:
+        mag = min = Filter::Nearest, mip = MipFilter::None;
+        break;
+    case FilterOverride::Bilinear:
+        mag = min = Filter::Linear, mip = MipFilter::None;
+        break;
+    case FilterOverride::Trilinear:
+        mag = min = Filter::Linear, mip = MipFilter::Linear;
+        break;
+    }
+    if (!(lod > 0.0f) || mip == MipFilter::None)
+        return sampleLevel(image, image.levels[0], sampler, lod > 0.0f ? min : mag, uv);
+    const float max_level = float(image.levels.size() - 1);
+    const float l = std::min(lod, max_level);
+    if (mip == MipFilter::Nearest)
+        return sampleLevel(image, image.levels[size_t(std::floor(l + 0.5f))], sampler, min, uv);
+    const size_t l0 = size_t(std::floor(l));
+    const size_t l1 = std::min(l0 + 1, image.levels.size() - 1);
+    const glm::vec4 a = sampleLevel(image, image.levels[l0], sampler, min, uv);
+    const glm::vec4 b = sampleLevel(image, image.levels[l1], sampler, min, uv);
+    return glm::mix(a, b, l - float(l0));
+}
+
+}  // namespace raster

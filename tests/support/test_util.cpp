@@ -1,0 +1,81 @@
+#include "support/test_util.h"
+
+#include <raster/check.h>
+#include <raster/task_pool.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace focal::test {
+
+raster::View pixelView(uint32_t width, uint32_t height, float d_px) {
+    raster::View v;
+    v.width = width;
+    v.height = height;
+    v.yfov = 2.0f * std::atan(0.5f * float(height) / d_px);
+    v.znear = 0.5f;
+    v.zfar = 4.0f * d_px;
+    v.focus_distance = d_px;
+    return v;
+}
+
+raster::Primitive& addMesh(raster::Scene& scene, std::vector<glm::vec3> positions,
+                           std::vector<uint32_t> indices, int32_t material,
+                           const glm::mat4& world) {
+    raster::Mesh mesh;
+    raster::Primitive prim;
+    prim.positions = std::move(positions);
+    prim.indices = std::move(indices);
+    prim.material = material;
+    mesh.primitives.push_back(std::move(prim));
+    scene.meshes.push_back(std::move(mesh));
+    scene.instances.push_back({uint32_t(scene.meshes.size() - 1), world});
+    return scene.meshes.back().primitives.back();
+}
+
+int32_t addMaterial(raster::Scene& scene, const raster::Material& material) {
+    scene.materials.push_back(material);
+    return int32_t(scene.materials.size() - 1);
+}
+
+raster::Material flatMaterial(glm::vec4 color, raster::AlphaMode mode, bool double_sided) {
+    raster::Material m;
+    m.base_color_factor = color;
+    m.alpha_mode = mode;
+    m.double_sided = double_sided;
+    m.unlit = true;
+    return m;
+}
+
+raster::Frame render(const raster::Scene& scene, const raster::View& view,
+                     const raster::RenderOptions& options, uint32_t threads,
+                     raster::FrameStats* stats) {
+    raster::TaskPool pool(threads);
+    raster::Renderer renderer(pool);
+    raster::Frame frame;
+    const raster::Status s = renderer.render(scene, view, options, frame, stats);
+    FOCAL_CHECK(s.ok());
+    return frame;
+}
+
+uint64_t hashFrame(const raster::Frame& frame) {
+    uint64_t h = 1469598103934665603ull;
+    auto mix = [&h](const void* data, size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (size_t i = 0; i < bytes; ++i) {
+            h ^= p[i];
+            h *= 1099511628211ull;
+        }
+    };
+    mix(frame.color.data(), frame.color.size() * sizeof(float));
+    mix(frame.depth.float32.data(), frame.depth.float32.size() * sizeof(float));
+    mix(frame.depth.unorm16.data(), frame.depth.unorm16.size() * sizeof(uint16_t));
+    return h;
+}
+
+glm::vec4 pixel(const raster::Frame& frame, uint32_t x, uint32_t y) {
+    const float* p = &frame.color[(size_t(y) * frame.width + x) * 4];
+    return {p[0], p[1], p[2], p[3]};
+}
+
+}  // namespace focal::test
