@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# README command (a): install what is missing, build Release, render the demo scene with depth
+# of field to out/demo.png (8-bit sRGB) and out/demo.exr (linear float), and print where.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+tools/install-deps.sh
+cmake --preset release >/dev/null
+cmake --build --preset release --target focal -- -j"$(nproc)"
+mkdir -p out
+focal=build/release/apps/focal
+"$focal" render builtin:demo -o out/demo.exr -o out/demo.png --stats out/demo.json
+echo "demo: images in $(pwd)/out/demo.png and $(pwd)/out/demo.exr (stats in out/demo.json)"

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# README command (b): install what is missing, build, and run the whole test suite:
+# the Release build (every test, warnings as errors) and the ASan+UBSan build (quick tier).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+tools/install-deps.sh
+jobs=$(nproc)
+cmake --preset release >/dev/null
+cmake --build --preset release -- -j"$jobs"
+ctest --preset release -j"$jobs"
+cmake --preset asan-ubsan >/dev/null
+cmake --build --preset asan-ubsan -- -j"$jobs"
+ctest --preset asan-ubsan -j"$jobs" -L quick
+echo "test: all suites passed"
