@@ -106,8 +106,8 @@ struct ChunkContext {
 
 // Snaps, culls and appends one triangle whose vertices are all inside the guard band.
 void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& draw,
-                   bool double_sided, uint32_t triangle, const ShadeVertex* v[3],
-                   const uint32_t ref[3]) {
+                   bool double_sided, uint32_t triangle, float max_distance,
+                   const ShadeVertex* v[3], const uint32_t ref[3]) {
     ScreenVertex s[3];
     for (int i = 0; i < 3; ++i)
         s[i] = toScreen(v[i]->clip, ctx.half_w, ctx.half_h);
@@ -153,6 +153,8 @@ void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& dr
     t.area2 = area2;
     t.draw = uint32_t(&draw - ctx.state.draws.data());
     t.triangle = triangle;
+    t.primitive_id = uint32_t(draw.first_triangle + triangle);
+    t.max_distance = max_distance;
     t.front_facing = front_facing;
     chunk.tris.push_back(t);
 }
@@ -178,11 +180,12 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
         ++chunk.triangles_culled;
         return;
     }
+    const float max_distance = std::max({v[0]->clip.w, v[1]->clip.w, v[2]->clip.w});
     const uint32_t crossing = outcode(v[0]->clip, kGuardBand, ctx.finite_far) |
                               outcode(v[1]->clip, kGuardBand, ctx.finite_far) |
                               outcode(v[2]->clip, kGuardBand, ctx.finite_far);
     if (crossing == 0) {
-        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, v, ref);
+        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, max_distance, v, ref);
         return;
     }
     // True clipping: only against the planes this triangle crosses (near/far, guard band).
@@ -201,7 +204,8 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
         const uint32_t fan_ref[3] = {base | kClippedVertex, (base + uint32_t(i)) | kClippedVertex,
                                      (base + uint32_t(i) + 1) | kClippedVertex};
         const ShadeVertex* fan[3] = {&poly[0], &poly[i], &poly[i + 1]};
-        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, fan, fan_ref);
+        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, max_distance, fan,
+                      fan_ref);
     }
 }
 

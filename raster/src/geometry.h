@@ -62,6 +62,8 @@ struct SetupTri {
     uint32_t vertex[3];   // ShadeVertex references: kClipped bit => chunk-local clipped vertex
     uint32_t draw;        // index into GeometryState::draws
     uint32_t triangle;    // index of the source triangle within its draw
+    uint32_t primitive_id;  // submission index of the source triangle over the whole frame
+    float max_distance;   // largest view distance (w) of the source triangle's vertices
     int32_t min_x, min_y, max_x, max_y;  // covered pixel bounds (inclusive), inside the viewport
     bool front_facing;    // as seen by the viewer, for double-sided lighting
 };

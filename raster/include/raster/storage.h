@@ -1,0 +1,77 @@
+// Storage formats of render targets: depth in 16-bit unorm or 32-bit float, colour (RGBA) in
+// 16-bit half (Imath) or 32-bit float. The choice is made at run time; loads return float.
+// Buffers are plain arrays owned by the target that holds them.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Imath/half.h>
+#include <glm/vec4.hpp>
+
+namespace raster {
+
+// 16-bit unorm or 32-bit float storage of D in [0,1] (see camera.h).
+enum class DepthFormat : uint8_t { Unorm16, Float32 };
+// RGBA colour storage.
+enum class ColorFormat : uint8_t { Half, Float32 };
+
+// Round-to-nearest unorm16 encoding of D in [0,1].
+inline uint16_t encodeUnorm16(float d) {
+    const float clamped = d < 0.0f ? 0.0f : (d > 1.0f ? 1.0f : d);
+    return uint16_t(clamped * 65535.0f + 0.5f);
+}
+
+struct DepthBuffer {
+    DepthFormat format = DepthFormat::Float32;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<uint16_t> unorm16;  // used when format == Unorm16
+    std::vector<float> float32;     // used when format == Float32
+
+    // Resizes and clears to the far value (D = 1).
+    void resize(DepthFormat depth_format, uint32_t w, uint32_t h);
+    // D at pixel index i, as a float in [0,1].
+    float load(size_t i) const {
+        return format == DepthFormat::Float32 ? float32[i] : float(unorm16[i]) * (1.0f / 65535.0f);
+    }
+    // The value D would have once stored (the depth test compares stored values).
+    float quantize(float d) const {
+        return format == DepthFormat::Float32 ? d : float(encodeUnorm16(d)) * (1.0f / 65535.0f);
+    }
+    void store(size_t i, float d) {
+        if (format == DepthFormat::Float32)
+            float32[i] = d;
+        else
+            unorm16[i] = encodeUnorm16(d);
+    }
+    size_t bytes() const { return unorm16.size() * 2 + float32.size() * 4; }
+};
+
+struct ColorBuffer {
+    ColorFormat format = ColorFormat::Float32;
+    std::vector<Imath::half> half;  // 4 per pixel, used when format == Half
+    std::vector<float> float32;     // 4 per pixel, used when format == Float32
+
+    // Resizes to `pixels` RGBA values, all set to `clear`.
+    void resize(ColorFormat color_format, size_t pixels, glm::vec4 clear);
+    glm::vec4 load(size_t i) const {
+        if (format == ColorFormat::Float32)
+            return {float32[4 * i], float32[4 * i + 1], float32[4 * i + 2], float32[4 * i + 3]};
+        return {float(half[4 * i]), float(half[4 * i + 1]), float(half[4 * i + 2]),
+                float(half[4 * i + 3])};
+    }
+    void store(size_t i, glm::vec4 c) {
+        if (format == ColorFormat::Float32) {
+            float32[4 * i] = c.r, float32[4 * i + 1] = c.g, float32[4 * i + 2] = c.b;
+            float32[4 * i + 3] = c.a;
+        } else {
+            half[4 * i] = Imath::half(c.r), half[4 * i + 1] = Imath::half(c.g);
+            half[4 * i + 2] = Imath::half(c.b), half[4 * i + 3] = Imath::half(c.a);
+        }
+    }
+    size_t bytes() const { return half.size() * 2 + float32.size() * 4; }
+};
+
+}  // namespace raster
