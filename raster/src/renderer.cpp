@@ -2,7 +2,10 @@
 
 #include "binning.h"
 #include "geometry.h"
+#include "sinks.h"
 #include "tile_raster.h"
+
+#include <algorithm>
 
 #include <chrono>
 #include <cmath>
@@ -15,7 +18,12 @@ namespace raster {
 struct Renderer::State {
     GeometryState geometry;
     std::vector<ChunkBins> bins;
+    RasterContext ctx;
     std::vector<TileCounters> tile_counters;
+    // Fragment-list collection: head per pixel, one node pool per tile, sort scratch per worker.
+    std::vector<uint32_t> list_head;
+    std::vector<std::vector<FragmentNode>> list_pools;
+    std::vector<std::vector<FragmentNode>> sort_scratch;
 };
 
 Renderer::Renderer(TaskPool& pool) : pool_(pool), state_(std::make_unique<State>()) {}
@@ -59,16 +67,92 @@ double msSince(std::chrono::steady_clock::time_point start) {
 }
 }  // namespace
 
-Status Renderer::render(const Scene& scene, const View& view, const RenderOptions& options,
-                        Frame& out, FrameStats* stats) {
+Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptions& options,
+                         FrameStats* stats) {
     if (Status s = validate(options); !s.ok())
         return s;
     if (Status s = validate(view); !s.ok())
         return s;
     State& st = *state_;
-    using Clock = std::chrono::steady_clock;
+    auto t0 = std::chrono::steady_clock::now();
+    runGeometry(pool_, scene, view, st.geometry);
+    const double ms_geometry = msSince(t0);
 
-    // Clear the targets.
+    t0 = std::chrono::steady_clock::now();
+    st.ctx = RasterContext{};
+    st.ctx.grid = makeTileGrid(view.width, view.height, options.tile_size);
+    binChunks(pool_, st.geometry, st.ctx.grid, st.bins);
+    const double ms_binning = msSince(t0);
+
+    st.ctx.geometry = &st.geometry;
+    st.ctx.bins = &st.bins;
+    st.ctx.shade.scene = &scene;
+    st.ctx.shade.eye = st.geometry.eye;
+    st.ctx.shade.mode = options.shading;
+    st.ctx.shade.filter = options.texture_filter;
+    // Default light: from above-left, behind the viewer (direction of travel).
+    st.ctx.shade.default_light_dir =
+        glm::normalize(0.35f * view.right - 0.6f * view.up + 0.7f * view.forward);
+    st.tile_counters.assign(st.ctx.grid.count(), TileCounters{});
+    if (stats) {
+        *stats = FrameStats{};
+        for (const GeometryChunk& c : st.geometry.chunks) {
+            stats->triangles_in += c.triangles_in;
+            stats->triangles_culled += c.triangles_culled;
+            stats->triangles_clipped += c.triangles_clipped;
+            stats->triangles_setup += c.tris.size();
+        }
+        stats->ms_geometry = ms_geometry;
+        stats->ms_binning = ms_binning;
+    }
+    return {};
+}
+
+namespace {
+
+// Adds the per-tile fragment counters in tile order.
+void addCounters(const std::vector<TileCounters>& tiles, FrameStats* stats) {
+    if (!stats)
+        return;
+    for (const TileCounters& tc : tiles) {
+        stats->fragments_covered += tc.covered;
+        stats->fragments_passed += tc.passed;
+    }
+}
+
+// Pixel rectangle [x0, x1) x [y0, y1) of a tile.
+struct TileRect {
+    uint32_t x0, y0, x1, y1;
+};
+TileRect tileRect(const TileGrid& g, uint32_t tile) {
+    const uint32_t x0 = (tile % g.tiles_x) * g.tile_size, y0 = (tile / g.tiles_x) * g.tile_size;
+    return {x0, y0, std::min(x0 + g.tile_size, g.width), std::min(y0 + g.tile_size, g.height)};
+}
+
+Status validate(const LayeredTargetDesc& desc) {
+    const size_t n = desc.bounds.size();
+    if (n < 2 || n - 1 > kMaxLayers)
+        return Status::error("layered target needs between 1 and " + std::to_string(kMaxLayers) +
+                             " layers (got " + std::to_string(n < 1 ? 0 : n - 1) + ")");
+    for (size_t i = 0; i < n; ++i) {
+        const bool last = i + 1 == n;
+        if (!(desc.bounds[i] > 0.0f) || (!last && !std::isfinite(desc.bounds[i])) ||
+            (i > 0 && !(desc.bounds[i] > desc.bounds[i - 1])))
+            return Status::error("layer bounds must be positive, finite (the last may be "
+                                 "infinite) and strictly increasing");
+    }
+    if (!(desc.overlap >= 0.0f && desc.overlap <= 1.0f))
+        return Status::error("layer overlap must be between 0 and 1");
+    return {};
+}
+
+}  // namespace
+
+Status Renderer::render(const Scene& scene, const View& view, const RenderOptions& options,
+                        Frame& out, FrameStats* stats) {
+    if (Status s = prepare(scene, view, options, stats); !s.ok())
+        return s;
+    State& st = *state_;
     out.width = view.width;
     out.height = view.height;
     const size_t pixels = size_t(view.width) * view.height;
@@ -80,51 +164,195 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
         out.color[i * 4 + 3] = 1.0f;
     }
     out.depth.resize(options.depth_format, view.width, view.height);
+    if (options.peel_depth &&
+        (options.peel_depth->format != options.depth_format ||
+         options.peel_depth->width != view.width || options.peel_depth->height != view.height))
+        return Status::error("the depth-peeling buffer must match the frame's size and format");
 
-    auto t0 = Clock::now();
-    runGeometry(pool_, scene, view, st.geometry);
-    const double ms_geometry = msSince(t0);
+    const auto t0 = std::chrono::steady_clock::now();
+    pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
+        FrameSink sink{out, options.peel_depth};
+        rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
+    });
+    if (stats) {
+        stats->ms_raster = msSince(t0);
+        stats->target_bytes = out.color.size() * sizeof(float) + out.depth.bytes();
+    }
+    addCounters(st.tile_counters, stats);
+    return {};
+}
 
-    t0 = Clock::now();
-    const TileGrid grid = makeTileGrid(view.width, view.height, options.tile_size);
-    binChunks(pool_, st.geometry, grid, st.bins);
-    const double ms_binning = msSince(t0);
+Status Renderer::renderLayers(const Scene& scene, const View& view, const RenderOptions& options,
+                              const LayeredTargetDesc& desc, LayeredTarget& out,
+                              FrameStats* stats) {
+    if (Status s = validate(desc); !s.ok())
+        return s;
+    if (Status s = prepare(scene, view, options, stats); !s.ok())
+        return s;
+    State& st = *state_;
+    const uint32_t layers = uint32_t(desc.bounds.size() - 1);
+    out.width = view.width;
+    out.height = view.height;
+    out.layer_count = layers;
+    out.desc = desc;
+    const size_t pixels = out.pixelCount();
+    out.color.resize(desc.color_format, pixels * layers, glm::vec4(0.0f));
+    out.depth.resize(desc.depth_format, view.width, view.height * layers);
+    out.gbuffer.assign(desc.gbuffer ? pixels * layers : 0, GSample{});
+    std::vector<LayerInterval> intervals(layers);
+    for (uint32_t l = 0; l < layers; ++l)
+        intervals[l] = overlappedInterval(desc, l);
 
-    t0 = Clock::now();
-    RasterContext ctx;
-    ctx.geometry = &st.geometry;
-    ctx.bins = &st.bins;
-    ctx.grid = grid;
-    ctx.frame = &out;
-    ctx.shade.scene = &scene;
-    ctx.shade.eye = st.geometry.eye;
-    ctx.shade.mode = options.shading;
-    ctx.shade.filter = options.texture_filter;
-    // Default light: from above-left, behind the viewer (direction of travel).
-    ctx.shade.default_light_dir =
-        glm::normalize(0.35f * view.right - 0.6f * view.up + 0.7f * view.forward);
-    st.tile_counters.assign(grid.count(), TileCounters{});
-    pool_.parallelFor(grid.count(), [&](uint32_t tile, uint32_t) {
-        rasterizeTile(ctx, tile, st.tile_counters[tile]);
+    auto t0 = std::chrono::steady_clock::now();
+    pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
+        LayerSink sink{out, intervals, desc.gbuffer};
+        rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
     });
     const double ms_raster = msSince(t0);
 
-    if (stats) {
-        *stats = FrameStats{};
-        for (const GeometryChunk& c : st.geometry.chunks) {
-            stats->triangles_in += c.triangles_in;
-            stats->triangles_culled += c.triangles_culled;
-            stats->triangles_clipped += c.triangles_clipped;
-            stats->triangles_setup += c.tris.size();
-        }
-        for (const TileCounters& tc : st.tile_counters) {
-            stats->fragments_covered += tc.covered;
-            stats->fragments_passed += tc.passed;
-        }
-        stats->ms_geometry = ms_geometry;
-        stats->ms_binning = ms_binning;
-        stats->ms_raster = ms_raster;
+    // Lee et al. §4.2, second pass: copy each covered pixel into every other layer whose
+    // overlapped interval holds its depth, with a manual depth test. Pixels stay where the
+    // triangle routing put them (the paper's approximation). Reads a per-pixel snapshot, so
+    // the result does not depend on the order of the copies.
+    t0 = std::chrono::steady_clock::now();
+    if (desc.routing == LayerRouting::MaxVertexDepth) {
+        pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
+            const TileRect r = tileRect(st.ctx.grid, tile);
+            float snapshot[kMaxLayers];
+            for (uint32_t y = r.y0; y < r.y1; ++y)
+                for (uint32_t x = r.x0; x < r.x1; ++x) {
+                    const size_t p = size_t(y) * view.width + x;
+                    for (uint32_t l = 0; l < layers; ++l)
+                        snapshot[l] = out.depth.load(out.index(l, p));
+                    for (uint32_t src = 0; src < layers; ++src) {
+                        if (!(snapshot[src] < 1.0f))
+                            continue;
+                        const float d = distanceFromDepth(view, snapshot[src]);
+                        for (uint32_t dst = 0; dst < layers; ++dst) {
+                            const size_t di = out.index(dst, p);
+                            if (dst == src || !(d >= intervals[dst].near_d) ||
+                                !(d < intervals[dst].far_d) ||
+                                !(snapshot[src] < out.depth.load(di)))
+                                continue;
+                            const size_t si = out.index(src, p);
+                            out.color.store(di, out.color.load(si));
+                            out.depth.store(di, snapshot[src]);
+                            if (desc.gbuffer)
+                                out.gbuffer[di] = out.gbuffer[si];
+                        }
+                    }
+                }
+        });
     }
+    if (stats) {
+        stats->ms_raster = ms_raster;
+        stats->ms_resolve = msSince(t0);
+        stats->target_bytes = out.bytes();
+    }
+    addCounters(st.tile_counters, stats);
+    return {};
+}
+
+Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
+                                     const RenderOptions& options, const FragmentListDesc& desc,
+                                     FragmentLists& out, FrameStats* stats) {
+    if (desc.node_capacity == 0)
+        return Status::error("fragment list node capacity must be at least 1");
+    if (Status s = prepare(scene, view, options, stats); !s.ok())
+        return s;
+    State& st = *state_;
+    const uint32_t tiles = st.ctx.grid.count();
+    const size_t pixels = size_t(view.width) * view.height;
+    st.list_head.assign(pixels, kNoNode);
+    st.list_pools.resize(tiles);
+    if (st.sort_scratch.size() < pool_.workerCount())
+        st.sort_scratch.resize(pool_.workerCount());
+
+    // Collection: every fragment, in primitive order, into its tile's pool.
+    auto t0 = std::chrono::steady_clock::now();
+    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
+        st.list_pools[tile].clear();
+        ListSink sink{st.list_head, st.list_pools[tile]};
+        rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
+    });
+    const double ms_raster = msSince(t0);
+    uint64_t collected = 0;
+    for (const std::vector<FragmentNode>& p : st.list_pools)
+        collected += p.size();
+    out = FragmentLists{};
+    out.width = view.width;
+    out.height = view.height;
+    out.desc = desc;
+    out.fragments_collected = collected;
+    out.node_capacity_used = desc.node_capacity;
+    if (collected > desc.node_capacity) {
+        if (desc.on_overflow == OverflowPolicy::Fail)
+            return Status::error("fragment list overflow: " + std::to_string(collected) +
+                                 " fragments collected but the node pool holds " +
+                                 std::to_string(desc.node_capacity) +
+                                 " (raise the capacity or let the pool grow)");
+        // Collection counted every fragment, so growing the pool to the count needed loses
+        // nothing: the lists below are complete.
+        out.grew = true;
+        out.node_capacity_used = uint32_t(std::min<uint64_t>(collected, UINT32_MAX));
+    }
+
+    // Resolve (Selgrad et al. §4): counts, prefix sum, then sort each list into its slot.
+    t0 = std::chrono::steady_clock::now();
+    const uint32_t cap = desc.max_per_pixel == 0 ? UINT32_MAX : desc.max_per_pixel;
+    out.offsets.assign(pixels + 1, 0);
+    std::vector<uint32_t> longest(tiles, 0);
+    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
+        const TileRect r = tileRect(st.ctx.grid, tile);
+        const std::vector<FragmentNode>& nodes = st.list_pools[tile];
+        for (uint32_t y = r.y0; y < r.y1; ++y)
+            for (uint32_t x = r.x0; x < r.x1; ++x) {
+                const size_t p = size_t(y) * view.width + x;
+                uint32_t n = 0;
+                for (uint32_t i = st.list_head[p]; i != kNoNode; i = nodes[i].next)
+                    ++n;
+                longest[tile] = std::max(longest[tile], n);
+                out.offsets[p + 1] = std::min(n, cap);
+            }
+    });
+    for (size_t p = 0; p < pixels; ++p)
+        out.offsets[p + 1] += out.offsets[p];
+    for (uint32_t l : longest)
+        out.max_list_length = std::max(out.max_list_length, l);
+    const uint32_t kept = out.offsets[pixels];
+    out.fragments_kept = kept;
+    out.color.resize(desc.color_format, kept, glm::vec4(0.0f));
+    out.depth.resize(desc.depth_format, kept, kept > 0 ? 1 : 0);
+    out.primitive.assign(kept, 0);
+    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
+        const TileRect r = tileRect(st.ctx.grid, tile);
+        const std::vector<FragmentNode>& nodes = st.list_pools[tile];
+        std::vector<FragmentNode>& list = st.sort_scratch[worker];
+        for (uint32_t y = r.y0; y < r.y1; ++y)
+            for (uint32_t x = r.x0; x < r.x1; ++x) {
+                const size_t p = size_t(y) * view.width + x;
+                list.clear();
+                for (uint32_t i = st.list_head[p]; i != kNoNode; i = nodes[i].next)
+                    list.push_back(nodes[i]);
+                // Total order: depth, then primitive id (never arrival order).
+                std::sort(list.begin(), list.end(),
+                          [](const FragmentNode& a, const FragmentNode& b) {
+                              return a.z < b.z || (a.z == b.z && a.primitive_id < b.primitive_id);
+                          });
+                const uint32_t first = out.offsets[p], count = out.offsets[p + 1] - first;
+                for (uint32_t k = 0; k < count; ++k) {
+                    out.color.store(first + k, list[k].color);
+                    out.depth.store(first + k, list[k].z);
+                    out.primitive[first + k] = list[k].primitive_id;
+                }
+            }
+    });
+    if (stats) {
+        stats->ms_raster = ms_raster;
+        stats->ms_resolve = msSince(t0);
+        stats->target_bytes = out.bytes();
+    }
+    addCounters(st.tile_counters, stats);
     return {};
 }
 

@@ -44,22 +44,17 @@ glm::vec4 baseColor(const ShadeContext& ctx, const Material& m, const UvFootprin
     return c;
 }
 
-glm::vec3 shadeColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
-                     glm::vec4 base, glm::vec3 world, glm::vec3 normal) {
-    glm::vec3 emissive = m.emissive_factor;
-    if (m.emissive_texture.image >= 0 && emissive != glm::vec3(0.0f))
-        emissive *= glm::vec3(sampleRef(ctx, m.emissive_texture, uv));
-    const bool unlit =
-        ctx.mode == ShadingMode::Unlit || (ctx.mode == ShadingMode::Material && m.unlit);
-    const glm::vec3 albedo(base);
-    if (unlit)
-        return albedo + emissive;
+namespace {
 
+// Lambert + energy-normalised Blinn-Phong over the scene's lights, plus ambient and emissive.
+glm::vec3 lightSurface(const ShadeContext& ctx, glm::vec3 albedo, float metallic_factor,
+                       float roughness_factor, glm::vec3 emissive, glm::vec3 world,
+                       glm::vec3 normal, glm::vec3 eye) {
     const float len = glm::length(normal);
     const glm::vec3 n = len > 0.0f ? normal / len : glm::vec3(0.0f, 0.0f, 1.0f);
-    const glm::vec3 v = glm::normalize(ctx.eye - world);
-    const float metallic = std::clamp(m.metallic_factor, 0.0f, 1.0f);
-    const float alpha = std::max(m.roughness_factor * m.roughness_factor, 0.02f);
+    const glm::vec3 v = glm::normalize(eye - world);
+    const float metallic = std::clamp(metallic_factor, 0.0f, 1.0f);
+    const float alpha = std::max(roughness_factor * roughness_factor, 0.02f);
     // Blinn-Phong exponent matching a GGX-like lobe of roughness alpha (Walter et al. 2007).
     const float shininess = 2.0f / (alpha * alpha) - 2.0f;
     const glm::vec3 diffuse = albedo * (1.0f - metallic) * (1.0f / kPi);
@@ -106,6 +101,48 @@ glm::vec3 shadeColor(const ShadeContext& ctx, const Material& m, const UvFootpri
         addLight(l, radiance * attenuation);
     }
     return result;
+}
+
+bool isUnlit(const ShadeContext& ctx, const Material& m) {
+    return ctx.mode == ShadingMode::Unlit || (ctx.mode == ShadingMode::Material && m.unlit);
+}
+
+glm::vec3 emissiveOf(const ShadeContext& ctx, const Material& m, const UvFootprint& uv) {
+    glm::vec3 emissive = m.emissive_factor;
+    if (m.emissive_texture.image >= 0 && emissive != glm::vec3(0.0f))
+        emissive *= glm::vec3(sampleRef(ctx, m.emissive_texture, uv));
+    return emissive;
+}
+
+}  // namespace
+
+glm::vec3 shadeColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
+                     glm::vec4 base, glm::vec3 world, glm::vec3 normal) {
+    const glm::vec3 emissive = emissiveOf(ctx, m, uv);
+    if (isUnlit(ctx, m))
+        return glm::vec3(base) + emissive;
+    return lightSurface(ctx, glm::vec3(base), m.metallic_factor, m.roughness_factor, emissive,
+                        world, normal, ctx.eye);
+}
+
+GSample surfaceSample(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
+                      glm::vec4 base, glm::vec3 normal) {
+    GSample g;
+    const float len = glm::length(normal);
+    g.normal = len > 0.0f ? normal / len : glm::vec3(0.0f, 0.0f, 1.0f);
+    g.base_color = glm::vec3(base);
+    g.metallic = m.metallic_factor;
+    g.roughness = m.roughness_factor;
+    g.emissive = emissiveOf(ctx, m, uv);
+    g.unlit = isUnlit(ctx, m) ? 1.0f : 0.0f;
+    return g;
+}
+
+glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world, glm::vec3 eye) {
+    if (g.unlit != 0.0f)
+        return g.base_color + g.emissive;
+    return lightSurface(ctx, g.base_color, g.metallic, g.roughness, g.emissive, world, g.normal,
+                        eye);
 }
 
 }  // namespace raster

@@ -4,6 +4,7 @@
 // Consumes the Scene's materials and images (read-only); stateless.
 #pragma once
 
+#include <raster/layered_target.h>
 #include <raster/renderer.h>
 #include <raster/scene.h>
 
@@ -37,5 +38,13 @@ glm::vec4 baseColor(const ShadeContext& ctx, const Material& m, const UvFootprin
 // fragment is seen from (unnormalised is fine).
 glm::vec3 shadeColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
                      glm::vec4 base, glm::vec3 world, glm::vec3 normal);
+
+// The surface parameters a G-buffer keeps so a hit can be re-shaded from another view
+// direction (Lee et al. 2009 §5): unit normal, albedo, metallic, roughness, emissive.
+GSample surfaceSample(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
+                      glm::vec4 base, glm::vec3 normal);
+
+// Shades a G-buffer sample at `world` as seen from `eye` (same model as shadeColor).
+glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world, glm::vec3 eye);
 
 }  // namespace raster

@@ -1,5 +1,7 @@
 #include "tile_raster.h"
 
+#include "sinks.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -25,8 +27,9 @@ struct TriangleRaster {
     bool has_colors;  // without vertex colours the colour is exactly white
 };
 
-// Perspective-correct barycentrics from the three edge values of one sample.
-void barycentrics(const TriangleRaster& tr, const int64_t e[3], float lambda[3], float persp[3]) {
+// Perspective-correct barycentrics from the three edge values of one sample; returns the view
+// distance d = w there (1/w is affine in screen space).
+float barycentrics(const TriangleRaster& tr, const int64_t e[3], float lambda[3], float persp[3]) {
     float q[3];
     for (int k = 0; k < 3; ++k) {
         lambda[k] = float(double(e[k]) * tr.inv_area2);
@@ -36,6 +39,7 @@ void barycentrics(const TriangleRaster& tr, const int64_t e[3], float lambda[3],
     const float inv = sum != 0.0f ? 1.0f / sum : 0.0f;
     for (int k = 0; k < 3; ++k)
         persp[k] = q[k] * inv;
+    return inv;
 }
 
 glm::vec2 interpolateUv(const TriangleRaster& tr, const float b[3]) {
@@ -43,8 +47,9 @@ glm::vec2 interpolateUv(const TriangleRaster& tr, const float b[3]) {
 }
 
 // One 2x2 quad at (qx, qy) (even coordinates). `e` holds the edge values at its top-left pixel.
+template <class Sink>
 void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, int32_t qy,
-               const int64_t e[3], TileCounters& counters) {
+               const int64_t e[3], Sink& sink, TileCounters& counters) {
     const SetupTri& t = *tr.tri;
     const int64_t step_x[3] = {tr.edges[0].a * kSubpixelOne, tr.edges[1].a * kSubpixelOne,
                                tr.edges[2].a * kSubpixelOne};
@@ -65,9 +70,9 @@ void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, i
         return;
 
     // Interpolate the whole quad (helper pixels included) so uv derivatives exist.
-    float lambda[4][3], persp[4][3];
+    float lambda[4][3], persp[4][3], distance[4];
     for (int p = 0; p < 4; ++p)
-        barycentrics(tr, pe[p], lambda[p], persp[p]);
+        distance[p] = barycentrics(tr, pe[p], lambda[p], persp[p]);
     const Material& m = *tr.material;
     const bool textured = m.base_color_texture.image >= 0 || m.emissive_texture.image >= 0;
     UvFootprint quad_uv[4];
@@ -81,8 +86,6 @@ void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, i
             quad_uv[p] = {uv[p], ddx, ddy};
     }
 
-    Frame& frame = *ctx.frame;
-    const bool unorm = frame.depth.format == DepthFormat::Unorm16;
     for (int p = 0; p < 4; ++p) {
         if (!(mask & (1u << p)))
             continue;
@@ -90,10 +93,11 @@ void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, i
         const int32_t x = qx + (p & 1), y = qy + (p >> 1);
         const size_t idx = size_t(y) * ctx.grid.width + size_t(x);
         const float* l = lambda[p];
-        const float z = std::clamp(l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2], 0.0f, 1.0f);
-        // Early depth test: legal here because this tile's owner is the only writer.
-        const uint16_t z16 = unorm ? encodeUnorm16(z) : 0;
-        if (unorm ? !(z16 < frame.depth.unorm16[idx]) : !(z < frame.depth.float32[idx]))
+        Fragment frag;
+        frag.z = std::clamp(l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2], 0.0f, 1.0f);
+        frag.distance = distance[p];
+        // Early depth test: legal because this tile's owner is the only writer of the pixel.
+        if (!sink.test(idx, frag.z, frag.distance))
             continue;
         const float* b = persp[p];
         const glm::vec4 vcolor =
@@ -103,8 +107,8 @@ void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, i
         if (m.alpha_mode == AlphaMode::Mask && !(base.a >= m.alpha_cutoff))
             continue;
         ++counters.passed;
-        const glm::vec3 world = b[0] * tr.v[0]->world + b[1] * tr.v[1]->world +
-                                b[2] * tr.v[2]->world;
+        const glm::vec3 world =
+            b[0] * tr.v[0]->world + b[1] * tr.v[1]->world + b[2] * tr.v[2]->world;
         glm::vec3 normal = tr.face_normal;
         if (tr.has_normals) {
             normal = b[0] * tr.v[0]->normal + b[1] * tr.v[1]->normal + b[2] * tr.v[2]->normal;
@@ -112,27 +116,19 @@ void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, i
                 normal = -normal;  // glTF: back faces of double-sided materials flip the normal
         }
         const glm::vec3 rgb = shadeColor(ctx.shade, m, quad_uv[p], base, world, normal);
-        float* dst = &frame.color[idx * 4];
-        if (m.alpha_mode == AlphaMode::Blend) {
-            // Over operator in primitive order; no depth write, as a GPU with blending does.
-            const float a = std::clamp(base.a, 0.0f, 1.0f);
-            dst[0] = rgb.r * a + dst[0] * (1.0f - a);
-            dst[1] = rgb.g * a + dst[1] * (1.0f - a);
-            dst[2] = rgb.b * a + dst[2] * (1.0f - a);
-            dst[3] = a + dst[3] * (1.0f - a);
-            continue;
-        }
-        dst[0] = rgb.r, dst[1] = rgb.g, dst[2] = rgb.b, dst[3] = 1.0f;
-        if (unorm)
-            frame.depth.unorm16[idx] = z16;
-        else
-            frame.depth.float32[idx] = z;
+        frag.blend = m.alpha_mode == AlphaMode::Blend;
+        frag.color = glm::vec4(rgb, frag.blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f);
+        frag.primitive_id = t.primitive_id;
+        if (sink.wants_gbuffer)
+            frag.g = surfaceSample(ctx.shade, m, quad_uv[p], base, normal);
+        sink.write(idx, frag);
     }
 }
 
+template <class Sink>
 void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, const SetupTri& t,
                        int32_t tile_x0, int32_t tile_y0, int32_t tile_x1, int32_t tile_y1,
-                       TileCounters& counters) {
+                       Sink& sink, TileCounters& counters) {
     const GeometryState& geo = *ctx.geometry;
     const Draw& draw = geo.draws[t.draw];
     const Primitive& prim = ctx.shade.scene->meshes[draw.mesh].primitives[draw.primitive];
@@ -148,6 +144,7 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     tr.face_normal = glm::cross(tr.v[1]->world - tr.v[0]->world, tr.v[2]->world - tr.v[0]->world);
     if (glm::dot(tr.face_normal, ctx.shade.eye - tr.v[0]->world) < 0.0f)
         tr.face_normal = -tr.face_normal;
+    sink.beginTriangle(t);
 
     // Pixel range of this triangle in this tile, widened to whole quads.
     const int32_t x0 = std::max(t.min_x, tile_x0) & ~1, y0 = std::max(t.min_y, tile_y0) & ~1;
@@ -171,7 +168,7 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
                 for (int k = 0; k < 3; ++k)
                     e[k] = tr.edges[k].at(centre(bx), centre(qy));
                 for (int32_t qx = bx; qx <= bx1; qx += 2) {
-                    shadeQuad(ctx, tr, qx, qy, e, counters);
+                    shadeQuad(ctx, tr, qx, qy, e, sink, counters);
                     for (int k = 0; k < 3; ++k)
                         e[k] += 2 * tr.edges[k].a * kSubpixelOne;
                 }
@@ -182,7 +179,8 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
 
 }  // namespace
 
-void rasterizeTile(const RasterContext& ctx, uint32_t tile, TileCounters& counters) {
+template <class Sink>
+void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters) {
     const TileGrid& g = ctx.grid;
     const int32_t ts = int32_t(g.tile_size);
     const int32_t tx0 = int32_t(tile % g.tiles_x) * ts, ty0 = int32_t(tile / g.tiles_x) * ts;
@@ -193,9 +191,13 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, TileCounters& counte
         const ChunkBins& bins = (*ctx.bins)[c];
         const GeometryChunk& chunk = geo.chunks[c];
         for (uint32_t i = bins.offsets[tile]; i < bins.offsets[tile + 1]; ++i)
-            rasterizeTriangle(ctx, chunk, chunk.tris[bins.items[i]], tx0, ty0, tx1, ty1,
+            rasterizeTriangle(ctx, chunk, chunk.tris[bins.items[i]], tx0, ty0, tx1, ty1, sink,
                               counters);
     }
 }
+
+template void rasterizeTile<FrameSink>(const RasterContext&, uint32_t, FrameSink&, TileCounters&);
+template void rasterizeTile<LayerSink>(const RasterContext&, uint32_t, LayerSink&, TileCounters&);
+template void rasterizeTile<ListSink>(const RasterContext&, uint32_t, ListSink&, TileCounters&);
 
 }  // namespace raster

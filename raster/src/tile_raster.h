@@ -1,13 +1,15 @@
-// Tile raster: coverage, depth test and shading for the pixels of one tile. Consumes the
-// geometry chunks and their bins; writes only the Frame pixels of the tile it is given, so tiles
-// run in parallel without locks. Triangles are replayed in chunk order, i.e. submission order.
+// Tile raster: coverage, depth interpolation and shading for the pixels of one tile, handing each
+// shaded fragment to an output-merger "sink" (the frame, the layered target, or the fragment
+// lists; see sinks.h). Consumes the geometry chunks and their bins; a sink writes only pixels of
+// the tile it is given, so tiles run in parallel without locks. Triangles are replayed in chunk
+// order, i.e. submission order, so every pixel sees its fragments in primitive order.
 #pragma once
 
 #include "binning.h"
 #include "geometry.h"
 #include "shading.h"
 
-#include <raster/frame.h>
+#include <raster/layered_target.h>
 
 #include <cstdint>
 #include <vector>
@@ -19,15 +21,27 @@ struct RasterContext {
     const std::vector<ChunkBins>* bins = nullptr;
     TileGrid grid;
     ShadeContext shade;
-    Frame* frame = nullptr;
 };
 
 struct TileCounters {
-    uint64_t covered = 0;
-    uint64_t passed = 0;
+    uint64_t covered = 0;  // samples inside a triangle
+    uint64_t passed = 0;   // of those, passed the sink's test and the alpha test
 };
 
-// Rasterizes every triangle binned to `tile` into ctx.frame.
-void rasterizeTile(const RasterContext& ctx, uint32_t tile, TileCounters& counters);
+// A shaded fragment as the output merger sees it.
+struct Fragment {
+    float z = 1.0f;         // stored depth D (camera.h)
+    float distance = 0.0f;  // view distance d
+    glm::vec4 color{0.0f};  // linear RGB and opacity (1 for OPAQUE and MASK)
+    bool blend = false;     // BLEND material: composite with "over", no depth write
+    uint32_t primitive_id = 0;
+    GSample g;  // filled only when the sink asks for it
+};
+
+// Rasterizes every triangle binned to `tile` and hands the fragments to `sink`.
+// Sink must provide: bool wants_gbuffer; void beginTriangle(const SetupTri&);
+// bool test(size_t pixel, float z, float distance); void write(size_t pixel, const Fragment&).
+template <class Sink>
+void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters);
 
 }  // namespace raster

@@ -5,7 +5,9 @@
 #pragma once
 
 #include <raster/camera.h>
+#include <raster/fragment_lists.h>
 #include <raster/frame.h>
+#include <raster/layered_target.h>
 #include <raster/scene.h>
 #include <raster/status.h>
 #include <raster/task_pool.h>
@@ -27,6 +29,10 @@ struct RenderOptions {
     DepthFormat depth_format = DepthFormat::Float32;
     ShadingMode shading = ShadingMode::Material;
     FilterOverride texture_filter = FilterOverride::Sampler;
+    // Depth peeling (Everitt 2001), for Renderer::render only: when set, fragments whose stored
+    // depth is not strictly behind this buffer's value (same size and format as the frame's) are
+    // discarded, so repeated renders peel the scene front to back.
+    const DepthBuffer* peel_depth = nullptr;
 };
 
 // Counts and stage times of one render. Counts are deterministic; times are not.
@@ -40,6 +46,8 @@ struct FrameStats {
     double ms_geometry = 0.0;
     double ms_binning = 0.0;
     double ms_raster = 0.0;
+    double ms_resolve = 0.0;  // layers: fragment-copy pass; lists: sort, cap and compact
+    uint64_t target_bytes = 0;  // memory held by the render target's buffers
 };
 
 class Renderer {
@@ -54,11 +62,31 @@ public:
     Status render(const Scene& scene, const View& view, const RenderOptions& options, Frame& out,
                   FrameStats* stats = nullptr);
 
+    // Layered rendering (Lee et al. 2009 §4.2) into desc.bounds.size() - 1 layers, each with its
+    // own depth buffer, routed as desc.routing says. options.depth_format is not used (the
+    // target has its own formats). Fails on invalid bounds (fewer than 2, not increasing, not
+    // positive, more than kMaxLayers layers) or overlap outside [0, 1].
+    Status renderLayers(const Scene& scene, const View& view, const RenderOptions& options,
+                        const LayeredTargetDesc& desc, LayeredTarget& out,
+                        FrameStats* stats = nullptr);
+
+    // Per-pixel fragment lists (Selgrad et al. 2015 §4): collect every fragment, then sort,
+    // keep the closest desc.max_per_pixel and compact. When more than desc.node_capacity nodes
+    // are needed: OverflowPolicy::Fail returns an error with both counts; Grow enlarges the
+    // pool to what was needed (out.grew, out.node_capacity_used).
+    Status renderFragmentLists(const Scene& scene, const View& view, const RenderOptions& options,
+                               const FragmentListDesc& desc, FragmentLists& out,
+                               FrameStats* stats = nullptr);
+
 private:
+    Status prepare(const Scene& scene, const View& view, const RenderOptions& options,
+                   FrameStats* stats);
     struct State;
     TaskPool& pool_;
     std::unique_ptr<State> state_;
 };
+
+constexpr uint32_t kMaxLayers = 64;
 
 // Validates options the user can set (tile size range, etc.).
 Status validate(const RenderOptions& options);

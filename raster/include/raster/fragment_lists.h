@@ -1,0 +1,54 @@
+// Fragment lists: every fragment of every primitive, per pixel, as GPU per-pixel linked lists
+// build them (Yang et al. 2010; Selgrad et al. 2015 §4) but deterministic. Produced by
+// Renderer::renderFragmentLists; consumed by the multi-layer method and the fragment dumps.
+//
+// Collection appends fragments in primitive order to per-pixel lists (a head index per pixel and
+// a next index per node in a node pool of explicit capacity). The resolve sorts each list by
+// depth (ties by primitive id), keeps the closest N and compacts all lists into consecutive
+// arrays with a prefix sum over the counts. Owns its arrays.
+#pragma once
+
+#include <raster/storage.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace raster {
+
+enum class OverflowPolicy : uint8_t {
+    Grow,  // re-render once with a node pool exactly as large as needed (reported in stats)
+    Fail,  // return an error naming the capacity and the count needed
+};
+
+struct FragmentListDesc {
+    uint32_t node_capacity = 1u << 22;  // nodes in the pool (fragments before the N cap)
+    uint32_t max_per_pixel = 4;         // closest N kept by the resolve; 0 keeps all
+    ColorFormat color_format = ColorFormat::Half;    // Selgrad et al.: half colour and opacity
+    DepthFormat depth_format = DepthFormat::Float32;  // and single-precision depth
+    OverflowPolicy on_overflow = OverflowPolicy::Grow;
+};
+
+struct FragmentLists {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    FragmentListDesc desc;
+    // Compacted, sorted lists: pixel i owns fragments [offsets[i], offsets[i+1]).
+    std::vector<uint32_t> offsets;
+    ColorBuffer color;     // linear RGB + opacity (alpha), one per fragment
+    DepthBuffer depth;     // stored depth D, one per fragment (width = count, height = 1)
+    std::vector<uint32_t> primitive;  // submission index of the fragment's triangle
+
+    // Counts from the collection pass.
+    uint64_t fragments_collected = 0;  // nodes appended (all fragments)
+    uint64_t fragments_kept = 0;       // after the closest-N cap
+    uint32_t max_list_length = 0;      // longest list before the cap
+    uint32_t node_capacity_used = 0;   // capacity of the pool that succeeded
+    bool grew = false;                 // the pool overflowed once and was grown
+
+    uint32_t count(size_t pixel) const { return offsets[pixel + 1] - offsets[pixel]; }
+    size_t bytes() const {
+        return offsets.size() * 4 + color.bytes() + depth.bytes() + primitive.size() * 4;
+    }
+};
+
+}  // namespace raster

@@ -1,0 +1,118 @@
+// Output mergers ("sinks") for the tile raster: what happens to a shaded fragment.
+//  - FrameSink: the ordinary framebuffer (depth test LESS, over-blending for BLEND).
+//  - LayerSink: layered rendering, Lee et al. 2009 §4.2 (one depth buffer per layer).
+//  - ListSink: per-pixel fragment linked lists, Yang et al. 2010 / Selgrad et al. 2015 §4.
+// A sink only touches pixels of the tile being rasterized, so one instance per tile is safe.
+#pragma once
+
+#include "geometry.h"
+#include "tile_raster.h"
+
+#include <raster/fragment_lists.h>
+#include <raster/frame.h>
+#include <raster/layered_target.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace raster {
+
+// Over operator for a BLEND fragment onto the stored colour (alpha accumulates coverage).
+inline glm::vec4 blendOver(glm::vec4 src, glm::vec4 dst) {
+    const float a = src.a;
+    return {src.r * a + dst.r * (1.0f - a), src.g * a + dst.g * (1.0f - a),
+            src.b * a + dst.b * (1.0f - a), a + dst.a * (1.0f - a)};
+}
+
+struct FrameSink {
+    Frame& frame;
+    const DepthBuffer* peel = nullptr;  // depth peeling: keep only fragments behind this
+    static constexpr bool wants_gbuffer = false;
+
+    void beginTriangle(const SetupTri&) {}
+    bool test(size_t pixel, float z, float) const {
+        const float stored = frame.depth.quantize(z);
+        return stored < frame.depth.load(pixel) && (!peel || stored > peel->load(pixel));
+    }
+    void write(size_t pixel, const Fragment& f) {
+        float* dst = &frame.color[pixel * 4];
+        const glm::vec4 c =
+            f.blend ? blendOver(f.color, glm::vec4(dst[0], dst[1], dst[2], dst[3])) : f.color;
+        dst[0] = c.r, dst[1] = c.g, dst[2] = c.b, dst[3] = c.a;
+        if (!f.blend)
+            frame.depth.store(pixel, f.z);
+    }
+};
+
+struct LayerSink {
+    LayeredTarget& target;
+    const std::vector<LayerInterval>& intervals;  // overlapped, one per layer
+    bool wants_gbuffer = false;
+    uint32_t triangle_layer = 0;  // MaxVertexDepth routing: the current triangle's layer
+
+    void beginTriangle(const SetupTri& t) {
+        if (target.desc.routing == LayerRouting::MaxVertexDepth)
+            triangle_layer = layerOf(target.desc, t.max_distance);
+    }
+    bool passes(uint32_t layer, size_t pixel, float z) const {
+        const size_t i = target.index(layer, pixel);
+        return target.depth.quantize(z) < target.depth.load(i);
+    }
+    bool holds(uint32_t layer, float distance) const {
+        return distance >= intervals[layer].near_d && distance < intervals[layer].far_d;
+    }
+    bool test(size_t pixel, float z, float distance) const {
+        if (target.desc.routing == LayerRouting::MaxVertexDepth)
+            return passes(triangle_layer, pixel, z);
+        for (uint32_t l = 0; l < target.layer_count; ++l)
+            if (holds(l, distance) && passes(l, pixel, z))
+                return true;
+        return false;
+    }
+    void writeLayer(uint32_t layer, size_t pixel, const Fragment& f) {
+        const size_t i = target.index(layer, pixel);
+        if (f.blend) {
+            target.color.store(i, blendOver(f.color, target.color.load(i)));
+            return;
+        }
+        target.color.store(i, f.color);
+        target.depth.store(i, f.z);
+        if (wants_gbuffer)
+            target.gbuffer[i] = f.g;
+    }
+    void write(size_t pixel, const Fragment& f) {
+        if (target.desc.routing == LayerRouting::MaxVertexDepth) {
+            writeLayer(triangle_layer, pixel, f);
+            return;
+        }
+        for (uint32_t l = 0; l < target.layer_count; ++l)
+            if (holds(l, f.distance) && passes(l, pixel, f.z))
+                writeLayer(l, pixel, f);
+    }
+};
+
+// One collected fragment: a node of a per-pixel linked list.
+struct FragmentNode {
+    glm::vec4 color;  // RGB + opacity, full precision until the resolve stores the chosen format
+    float z;
+    uint32_t primitive_id;
+    uint32_t next;  // index of the next node in this tile's pool, kNoNode at the tail
+};
+constexpr uint32_t kNoNode = 0xffffffffu;
+
+// Collects into the tile's own node pool (appending at the list head, as an atomic exchange on
+// the GPU does); pools are concatenated in tile order afterwards, so node order is deterministic.
+struct ListSink {
+    std::vector<uint32_t>& head;     // per pixel: first node (tile-local index) or kNoNode
+    std::vector<FragmentNode>& pool;  // this tile's nodes
+    static constexpr bool wants_gbuffer = false;
+
+    void beginTriangle(const SetupTri&) {}
+    bool test(size_t, float, float) const { return true; }  // every fragment is collected
+    void write(size_t pixel, const Fragment& f) {
+        pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
+        head[pixel] = uint32_t(pool.size() - 1);
+    }
+};
+
+}  // namespace raster

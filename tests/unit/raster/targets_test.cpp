@@ -1,0 +1,285 @@
+// Layered target and fragment lists (issue 5).
+#include "support/test_util.h"
+
+#include <raster/task_pool.h>
+#include <scenes/builtin.h>
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace focal::test {
+namespace {
+
+using raster::AlphaMode;
+using raster::LayerRouting;
+
+// Quads at several depths that overlap on screen, none crossing the layer bounds below, plus one
+// long slanted quad from d = 2 to d = 14 that crosses them.
+raster::Scene stackScene(bool with_crossing) {
+    raster::Scene s;
+    s.background = glm::vec3(0.0f);
+    // 2.95, 6.1 and 11.5 lie in the 10% overlap of two layers (bounds 3, 6, 12 below).
+    const float depths[] = {2.0f, 2.95f, 4.0f, 6.1f, 8.0f, 11.5f, 16.0f, 30.0f};
+    for (int i = 0; i < 8; ++i) {
+        const float d = depths[i], h = 0.25f * d;
+        const float cx = 0.12f * d * float(i % 3 - 1), cy = 0.1f * d * float(i % 2) - 0.05f * d;
+        const int32_t m = addMaterial(
+            s, flatMaterial({0.1f + 0.1f * float(i), 0.9f - 0.1f * float(i), 0.5f, 1.0f}));
+        addMesh(s, {{cx - h, cy - h, -d}, {cx + h, cy - h, -d}, {cx + h, cy + h, -d},
+                    {cx - h, cy + h, -d}},
+                {0, 1, 2, 0, 2, 3}, m);
+    }
+    if (with_crossing) {
+        const int32_t m = addMaterial(s, flatMaterial({1.0f, 1.0f, 0.0f, 1.0f}));
+        addMesh(s, {{-0.3f, -0.2f, -2.2f}, {0.3f, -0.2f, -2.2f}, {0.3f, 0.6f, -14.0f},
+                    {-0.3f, 0.6f, -14.0f}},
+                {0, 1, 2, 0, 2, 3}, m);
+    }
+    return s;
+}
+
+raster::View stackView() {
+    raster::View v = pixelView(96, 72, 80.0f);
+    v.znear = 1.0f;
+    v.zfar = 100.0f;
+    return v;
+}
+
+raster::LayeredTarget layers(const raster::Scene& s, const raster::View& v,
+                             raster::LayeredTargetDesc desc, uint32_t threads = 0,
+                             uint32_t tile = 64) {
+    raster::TaskPool pool(threads);
+    raster::Renderer r(pool);
+    raster::LayeredTarget out;
+    raster::RenderOptions o;
+    o.tile_size = tile;
+    EXPECT_TRUE(r.renderLayers(s, v, o, desc, out).ok());
+    return out;
+}
+
+raster::FragmentLists lists(const raster::Scene& s, const raster::View& v,
+                            raster::FragmentListDesc desc, uint32_t threads = 0,
+                            uint32_t tile = 64) {
+    raster::TaskPool pool(threads);
+    raster::Renderer r(pool);
+    raster::FragmentLists out;
+    raster::RenderOptions o;
+    o.tile_size = tile;
+    EXPECT_TRUE(r.renderFragmentLists(s, v, o, desc, out).ok());
+    return out;
+}
+
+raster::LayeredTargetDesc stackDesc(LayerRouting routing, float overlap) {
+    raster::LayeredTargetDesc d;
+    d.bounds = {1.0f, 3.0f, 6.0f, 12.0f, 100.0f};
+    d.routing = routing;
+    d.overlap = overlap;
+    return d;
+}
+
+uint64_t hashLayers(const raster::LayeredTarget& t) {
+    raster::Frame f;
+    f.color = t.color.float32;
+    for (const Imath::half h : t.color.half)
+        f.color.push_back(float(h));
+    f.depth = t.depth;
+    return hashFrame(f);
+}
+
+TEST(LayeredTarget, ExactRoutingEqualsRendersClippedToEachLayer) {
+    const raster::Scene s = stackScene(true);
+    const raster::View v = stackView();
+    const raster::LayeredTargetDesc desc = stackDesc(LayerRouting::PerFragment, 0.1f);
+    const raster::LayeredTarget t = layers(s, v, desc);
+    for (uint32_t l = 0; l < t.layer_count; ++l) {
+        // The paper's definition: a render with clipping planes at the layer's bounds.
+        const raster::LayerInterval iv = raster::overlappedInterval(desc, l);
+        raster::View clipped = v;
+        clipped.znear = std::max(iv.near_d, v.znear);
+        clipped.zfar = std::min(iv.far_d, v.zfar);
+        const raster::Frame ref = render(s, clipped);
+        size_t mismatched = 0, covered = 0;
+        for (size_t p = 0; p < t.pixelCount(); ++p) {
+            const bool in_ref = ref.depth.load(p) < 1.0f;
+            const glm::vec4 c = t.color.load(t.index(l, p));
+            covered += in_ref;
+            if (in_ref != (c.a > 0.0f)) {
+                ++mismatched;  // only where a clipped triangle's new edge is snapped differently
+                continue;
+            }
+            if (in_ref)
+                EXPECT_EQ(glm::vec3(c), glm::vec3(pixel(ref, uint32_t(p % v.width),
+                                                         uint32_t(p / v.width))))
+                    << "layer " << l << " pixel " << p;
+        }
+        EXPECT_GT(covered, 0u) << "layer " << l;
+        EXPECT_LE(mismatched, t.width) << "layer " << l;  // at most a row's worth along the cut
+    }
+}
+
+TEST(LayeredTarget, PaperRoutingDiffersOnlyWhereTrianglesCrossBounds) {
+    const raster::View v = stackView();
+    // Without crossing triangles and without overlap the two policies agree bit for bit.
+    const raster::Scene plain = stackScene(false);
+    EXPECT_EQ(hashLayers(layers(plain, v, stackDesc(LayerRouting::MaxVertexDepth, 0.0f))),
+              hashLayers(layers(plain, v, stackDesc(LayerRouting::PerFragment, 0.0f))));
+    // With the slanted quad, differences stay inside its screen footprint.
+    const raster::Scene crossing = stackScene(true);
+    const raster::LayeredTarget paper = layers(crossing, v, stackDesc(LayerRouting::MaxVertexDepth, 0.0f));
+    const raster::LayeredTarget exact = layers(crossing, v, stackDesc(LayerRouting::PerFragment, 0.0f));
+    raster::Scene only_crossing = crossing;
+    only_crossing.instances.erase(only_crossing.instances.begin(),
+                                  only_crossing.instances.end() - 1);
+    const raster::Frame footprint = render(only_crossing, v);
+    size_t differing = 0;
+    for (uint32_t l = 0; l < paper.layer_count; ++l)
+        for (size_t p = 0; p < paper.pixelCount(); ++p) {
+            const size_t i = paper.index(l, p);
+            if (paper.color.load(i) == exact.color.load(i) &&
+                paper.depth.load(i) == exact.depth.load(i))
+                continue;
+            ++differing;
+            EXPECT_LT(footprint.depth.load(p), 1.0f) << "layer " << l << " pixel " << p;
+        }
+    EXPECT_GT(differing, 0u);  // the crossing quad does land in other layers
+}
+
+TEST(LayeredTarget, BitIdenticalAcrossThreadsAndTiles) {
+    const raster::Scene s = stackScene(true);
+    const raster::View v = stackView();
+    for (LayerRouting routing : {LayerRouting::MaxVertexDepth, LayerRouting::PerFragment}) {
+        const uint64_t ref = hashLayers(layers(s, v, stackDesc(routing, 0.1f), 0, 64));
+        for (uint32_t threads : {1u, 2u, 3u, 8u})
+            for (uint32_t tile : {16u, 32u, 128u})
+                EXPECT_EQ(hashLayers(layers(s, v, stackDesc(routing, 0.1f), threads, tile)), ref);
+    }
+}
+
+TEST(LayeredTarget, HalfAndUnorm16StorageStayWithinTheirPrecision) {
+    const raster::Scene s = stackScene(true);
+    const raster::View v = stackView();
+    raster::LayeredTargetDesc d = stackDesc(LayerRouting::PerFragment, 0.1f);
+    const raster::LayeredTarget full = layers(s, v, d);
+    d.color_format = raster::ColorFormat::Half;
+    d.depth_format = raster::DepthFormat::Unorm16;
+    const raster::LayeredTarget small = layers(s, v, d);
+    EXPECT_LT(small.bytes(), full.bytes());
+    for (size_t i = 0; i < full.pixelCount() * full.layer_count; ++i) {
+        const float zf = full.depth.load(i), zs = small.depth.load(i);
+        if (zf < 1.0f && std::abs(zf - zs) <= 0.5f / 65535.0f + 1e-7f) {
+            const glm::vec4 cf = full.color.load(i), cs = small.color.load(i);
+            for (int k = 0; k < 4; ++k)  // half: 11 significant bits
+                EXPECT_LE(std::abs(cf[k] - cs[k]), std::abs(cf[k]) * 0x1p-11f + 1e-7f);
+        }
+    }
+}
+
+TEST(LayeredTarget, InvalidBoundsAreErrors) {
+    raster::TaskPool pool(0);
+    raster::Renderer r(pool);
+    raster::LayeredTarget out;
+    raster::LayeredTargetDesc d;
+    for (std::vector<float> bounds : std::vector<std::vector<float>>{
+             {}, {1.0f}, {2.0f, 1.0f}, {0.0f, 1.0f}, {1.0f, NAN}, {1.0f, 1.0f}}) {
+        d.bounds = bounds;
+        EXPECT_FALSE(r.renderLayers(stackScene(false), stackView(), {}, d, out).ok());
+    }
+    d.bounds = {1.0f, 2.0f};
+    d.overlap = 1.5f;
+    EXPECT_FALSE(r.renderLayers(stackScene(false), stackView(), {}, d, out).ok());
+}
+
+TEST(FragmentLists, EqualDepthPeeling) {
+    const raster::Scene s = stackScene(true);
+    const raster::View v = stackView();
+    raster::FragmentListDesc desc;
+    desc.max_per_pixel = 0;  // keep all
+    desc.color_format = raster::ColorFormat::Float32;
+    const raster::FragmentLists fl = lists(s, v, desc);
+    EXPECT_GT(fl.max_list_length, 3u);
+    // Peel front to back with the ordinary frame target; peel k is the k-th list entry.
+    raster::Frame peeled = render(s, v);
+    for (uint32_t k = 0; k < fl.max_list_length; ++k) {
+        for (size_t p = 0; p < size_t(v.width) * v.height; ++p) {
+            if (k < fl.count(p)) {
+                const uint32_t i = fl.offsets[p] + k;
+                ASSERT_EQ(fl.depth.load(i), peeled.depth.load(p)) << "peel " << k << " px " << p;
+                EXPECT_EQ(fl.color.load(i), pixel(peeled, uint32_t(p % v.width),
+                                                  uint32_t(p / v.width)));
+            } else {
+                EXPECT_EQ(peeled.depth.load(p), 1.0f) << "peel " << k << " px " << p;
+            }
+        }
+        raster::RenderOptions o;
+        o.peel_depth = &peeled.depth;
+        raster::Frame next = render(s, v, o);
+        peeled = std::move(next);
+    }
+}
+
+TEST(FragmentLists, CapKeepsTheClosestN) {
+    const raster::Scene s = stackScene(true);
+    const raster::View v = stackView();
+    raster::FragmentListDesc all;
+    all.max_per_pixel = 0;
+    raster::FragmentListDesc two = all;
+    two.max_per_pixel = 2;
+    const raster::FragmentLists a = lists(s, v, all), b = lists(s, v, two);
+    EXPECT_EQ(a.fragments_collected, b.fragments_collected);
+    EXPECT_LT(b.fragments_kept, a.fragments_kept);
+    for (size_t p = 0; p < size_t(v.width) * v.height; ++p) {
+        ASSERT_EQ(b.count(p), std::min(a.count(p), 2u));
+        for (uint32_t k = 0; k < b.count(p); ++k) {
+            EXPECT_EQ(b.depth.load(b.offsets[p] + k), a.depth.load(a.offsets[p] + k));
+            EXPECT_EQ(b.primitive[b.offsets[p] + k], a.primitive[a.offsets[p] + k]);
+        }
+        for (uint32_t k = 1; k < a.count(p); ++k)  // sorted front to back
+            EXPECT_LE(a.depth.load(a.offsets[p] + k - 1), a.depth.load(a.offsets[p] + k));
+    }
+}
+
+TEST(FragmentLists, OverflowFailsOrGrowsWithoutLoss) {
+    const raster::Scene s = stackScene(true);
+    const raster::View v = stackView();
+    raster::FragmentListDesc desc;
+    const raster::FragmentLists big = lists(s, v, desc);
+    ASSERT_GT(big.fragments_collected, 100u);
+    desc.node_capacity = 100;
+    desc.on_overflow = raster::OverflowPolicy::Fail;
+    raster::TaskPool pool(2);
+    raster::Renderer r(pool);
+    raster::FragmentLists out;
+    const raster::Status st = r.renderFragmentLists(s, v, {}, desc, out);
+    ASSERT_FALSE(st.ok());
+    EXPECT_NE(st.message().find(std::to_string(big.fragments_collected)), std::string::npos)
+        << st.message();
+    EXPECT_NE(st.message().find("100"), std::string::npos);
+    desc.on_overflow = raster::OverflowPolicy::Grow;
+    ASSERT_TRUE(r.renderFragmentLists(s, v, {}, desc, out).ok());
+    EXPECT_TRUE(out.grew);
+    EXPECT_EQ(out.node_capacity_used, big.fragments_collected);
+    EXPECT_EQ(out.offsets, big.offsets);
+    EXPECT_EQ(out.primitive, big.primitive);
+}
+
+TEST(FragmentLists, BitIdenticalAcrossThreadsAndTilesOnFoliage) {
+    raster::Result<raster::Scene> s = scenes::makeBuiltinScene("foliage");
+    ASSERT_TRUE(s.ok());
+    const raster::View v = raster::viewFromCamera(s->cameras[0], 120, 90);
+    const raster::FragmentLists ref = lists(*s, v, {}, 0, 64);
+    EXPECT_GT(ref.max_list_length, 4u);
+    for (uint32_t threads : {1u, 3u, 8u})
+        for (uint32_t tile : {16u, 32u, 128u}) {
+            const raster::FragmentLists other = lists(*s, v, {}, threads, tile);
+            EXPECT_EQ(other.offsets, ref.offsets);
+            EXPECT_EQ(other.primitive, ref.primitive);
+            EXPECT_EQ(other.depth.float32, ref.depth.float32);
+            ASSERT_EQ(other.color.half.size(), ref.color.half.size());
+            for (size_t i = 0; i < ref.color.half.size(); ++i)
+                ASSERT_EQ(other.color.half[i].bits(), ref.color.half[i].bits());
+        }
+}
+
+}  // namespace
+}  // namespace focal::test
