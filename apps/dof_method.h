@@ -1,0 +1,65 @@
+// How `focal render --method NAME` runs a depth-of-field method that lives in dof/: each method
+// adds its own options to the render command and runs from a MethodInput. The table of methods
+// is in apps/methods.cpp (one line per method); render_command.cpp dispatches through it.
+#pragma once
+
+#include <dof/lens.h>
+#include <dof/lens_samples.h>
+
+#include <raster/camera.h>
+#include <raster/renderer.h>
+#include <raster/scene.h>
+#include <raster/status.h>
+#include <raster/task_pool.h>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+namespace focal {
+
+// What every method gets: the scene, the pinhole view through the lens centre, the thin lens
+// (from --aperture-radius/--fstop/--focus-distance/...), the lens samples shared with accum
+// (--samples, --lens-pattern, --aperture-shape/-blades/-rotation/-image, --seed), the pool and
+// the raster options (--tile, --depth-format, --shading, --texture-filter).
+struct MethodInput {
+    const raster::Scene& scene;
+    const raster::View& view;
+    const dof::ThinLens& lens;
+    const dof::LensSampleSet& lens_samples;
+    raster::TaskPool& pool;
+    const raster::RenderOptions& options;
+    // Storage of the layered target / fragment lists (--precision 16|32, --target-color,
+    // --target-depth); unset: the method's own default (e.g. Selgrad et al.: half colour, float
+    // depth).
+    std::optional<raster::ColorFormat> target_color;
+    std::optional<raster::DepthFormat> target_depth;
+};
+
+// What it returns for one run.
+struct MethodOutput {
+    std::vector<float> rgba;   // linear RGBA, view.width * view.height * 4, top row first
+    std::vector<float> depth;  // optional: linear distance along the view axis per pixel
+    nlohmann::json params;     // every parameter the method used (recorded in --stats)
+    nlohmann::json counts;     // method-specific counters (recorded in --stats)
+    std::vector<std::pair<std::string, double>> stage_ms;  // per-stage times, in stage order
+};
+
+struct MethodEntry {
+    std::string name;
+    std::string summary;  // one line for --help
+    // Adds the method's options to `focal render` (values live in the method's own statics-free
+    // args object owned by the entry).
+    std::function<void(CLI::App& render)> add_options;
+    std::function<raster::Status(const MethodInput&, MethodOutput&)> run;
+};
+
+// The methods beyond pinhole and accum, in a fixed order (apps/methods.cpp).
+std::vector<MethodEntry>& methodTable();
+
+}  // namespace focal
