@@ -1,5 +1,7 @@
 #include <raster/renderer.h>
 
+#include <raster/surface_shading.h>
+
 #include "binning.h"
 #include "geometry.h"
 #include "sinks.h"
@@ -90,9 +92,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.eye = st.geometry.eye;
     st.ctx.shade.mode = options.shading;
     st.ctx.shade.filter = options.texture_filter;
-    // Default light: from above-left, behind the viewer (direction of travel).
-    st.ctx.shade.default_light_dir =
-        glm::normalize(0.35f * view.right - 0.6f * view.up + 0.7f * view.forward);
+    st.ctx.shade.default_light_dir = defaultLightDirection(view);
     st.tile_counters.assign(st.ctx.grid.count(), TileCounters{});
     if (stats) {
         *stats = FrameStats{};
