@@ -13,10 +13,11 @@
 
 namespace raster {
 
-// Linear RGB leaving `world` towards `eye` for the surface `g` (g.unlit: base colour+emissive).
+// Linear RGB leaving `world` towards `eye` for the surface `g` (g.unlit: base colour+emissive;
+// the shading mode was applied when the sample was written).
 // `view` supplies the default light when the scene has none (as Renderer::render does).
-glm::vec3 shadeSurface(const Scene& scene, const View& view, ShadingMode mode, const GSample& g,
-                       glm::vec3 world, glm::vec3 eye);
+glm::vec3 shadeSurface(const Scene& scene, const View& view, const GSample& g, glm::vec3 world,
+                       glm::vec3 eye);
 
 // The direction of travel of the default light for `view` (from above-left, behind the viewer).
 glm::vec3 defaultLightDirection(const View& view);
