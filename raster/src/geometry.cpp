@@ -80,11 +80,6 @@ int clipPolygon(ShadeVertex* poly, int n, ShadeVertex* scratch, uint32_t planes,
     return n;
 }
 
-struct ScreenVertex {
-    int32_t x, y;
-    float z, inv_w;
-};
-
 ScreenVertex toScreen(const glm::vec4& clip, float half_w, float half_h) {
     const float inv_w = 1.0f / clip.w;
     const float px = (clip.x * inv_w + 1.0f) * half_w;
@@ -107,10 +102,7 @@ struct ChunkContext {
 // Snaps, culls and appends one triangle whose vertices are all inside the guard band.
 void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& draw,
                    bool double_sided, uint32_t triangle, float max_distance,
-                   const ShadeVertex* v[3], const uint32_t ref[3]) {
-    ScreenVertex s[3];
-    for (int i = 0; i < 3; ++i)
-        s[i] = toScreen(v[i]->clip, ctx.half_w, ctx.half_h);
+                   const ScreenVertex s[3], const uint32_t ref[3]) {
     int64_t area2 = int64_t(s[1].x - s[0].x) * (s[2].y - s[0].y) -
                     int64_t(s[1].y - s[0].y) * (s[2].x - s[0].x);
     if (area2 == 0) {
@@ -165,27 +157,25 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
     const Material& material = materialOf(ctx.scene, prim);
     uint32_t ref[3];
     const ShadeVertex* v[3];
+    const VertexCodes* code[3];
     for (int i = 0; i < 3; ++i) {
         ref[i] = draw.first_vertex + prim.indices[size_t(triangle) * 3 + size_t(i)];
         v[i] = &ctx.state.vertices[ref[i]];
+        code[i] = &ctx.state.codes[ref[i]];
     }
     ++chunk.triangles_in;
-    const bool finite = std::isfinite(v[0]->clip.x + v[0]->clip.y + v[0]->clip.z + v[0]->clip.w +
-                                      v[1]->clip.x + v[1]->clip.y + v[1]->clip.z + v[1]->clip.w +
-                                      v[2]->clip.x + v[2]->clip.y + v[2]->clip.z + v[2]->clip.w);
     // Outside one frustum plane entirely (the view frustum, k = 1): nothing to draw.
-    if (!finite || (outcode(v[0]->clip, 1.0f, ctx.finite_far) &
-                    outcode(v[1]->clip, 1.0f, ctx.finite_far) &
-                    outcode(v[2]->clip, 1.0f, ctx.finite_far)) != 0) {
+    if (!(code[0]->finite && code[1]->finite && code[2]->finite) ||
+        (code[0]->frustum & code[1]->frustum & code[2]->frustum) != 0) {
         ++chunk.triangles_culled;
         return;
     }
     const float max_distance = std::max({v[0]->clip.w, v[1]->clip.w, v[2]->clip.w});
-    const uint32_t crossing = outcode(v[0]->clip, kGuardBand, ctx.finite_far) |
-                              outcode(v[1]->clip, kGuardBand, ctx.finite_far) |
-                              outcode(v[2]->clip, kGuardBand, ctx.finite_far);
+    const uint32_t crossing = uint32_t(code[0]->guard | code[1]->guard | code[2]->guard);
     if (crossing == 0) {
-        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, max_distance, v, ref);
+        const ScreenVertex s[3] = {ctx.state.screen[ref[0]], ctx.state.screen[ref[1]],
+                                   ctx.state.screen[ref[2]]};
+        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, max_distance, s, ref);
         return;
     }
     // True clipping: only against the planes this triangle crosses (near/far, guard band).
@@ -203,7 +193,9 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
     for (int i = 1; i + 1 < n; ++i) {
         const uint32_t fan_ref[3] = {base | kClippedVertex, (base + uint32_t(i)) | kClippedVertex,
                                      (base + uint32_t(i) + 1) | kClippedVertex};
-        const ShadeVertex* fan[3] = {&poly[0], &poly[i], &poly[i + 1]};
+        const ScreenVertex fan[3] = {toScreen(poly[0].clip, ctx.half_w, ctx.half_h),
+                                     toScreen(poly[i].clip, ctx.half_w, ctx.half_h),
+                                     toScreen(poly[i + 1].clip, ctx.half_w, ctx.half_h)};
         setupTriangle(ctx, chunk, draw, material.double_sided, triangle, max_distance, fan,
                       fan_ref);
     }
@@ -234,8 +226,12 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
     }
     state.eye = view.eye + view.lens_offset.x * view.right + view.lens_offset.y * view.up;
 
-    // Vertex transform, in blocks of vertices.
+    // Vertex transform, clip codes and viewport transform, in blocks of vertices.
     state.vertices.resize(vertex_count);
+    state.codes.resize(vertex_count);
+    state.screen.resize(vertex_count);
+    const float half_w = 0.5f * float(view.width), half_h = 0.5f * float(view.height);
+    const bool finite_far = view.zfar > 0.0f;
     const glm::mat4 view_proj = projectionMatrix(view) * viewMatrix(view);
     const uint32_t blocks = (vertex_count + kVerticesPerBlock - 1) / kVerticesPerBlock;
     pool.parallelFor(blocks, [&](uint32_t block, uint32_t) {
@@ -259,6 +255,14 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
                                               : draw.normal_matrix * prim.normals[local];
             out.uv = prim.texcoords0.empty() ? glm::vec2(0.0f) : prim.texcoords0[local];
             out.color = prim.colors.empty() ? glm::vec4(1.0f) : prim.colors[local];
+            VertexCodes& code = state.codes[vi];
+            const glm::vec4& c = out.clip;
+            code.finite = std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) &&
+                          std::isfinite(c.w);
+            code.frustum = uint8_t(outcode(c, 1.0f, finite_far));
+            code.guard = uint8_t(outcode(c, kGuardBand, finite_far));
+            if (code.finite && code.guard == 0)
+                state.screen[vi] = toScreen(c, half_w, half_h);
         }
     });
 
@@ -266,8 +270,7 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
     const uint32_t chunk_count =
         uint32_t((triangle_count + kTrianglesPerChunk - 1) / kTrianglesPerChunk);
     state.chunks.resize(chunk_count);
-    const ChunkContext ctx{scene, view, state, 0.5f * float(view.width),
-                           0.5f * float(view.height), view.zfar > 0.0f};
+    const ChunkContext ctx{scene, view, state, half_w, half_h, finite_far};
     pool.parallelFor(chunk_count, [&](uint32_t c, uint32_t) {
         GeometryChunk& chunk = state.chunks[c];
         chunk.tris.clear();

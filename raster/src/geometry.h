@@ -53,6 +53,23 @@ struct ShadeVertex {
     glm::vec4 color;
 };
 
+// A vertex after the viewport transform: snapped position, stored depth and 1/w. Computed once
+// per vertex for unclipped triangles, so triangles sharing a vertex share its snapped position.
+struct ScreenVertex {
+    int32_t x, y;  // 24.8 fixed point pixels, y down
+    float z;       // stored depth D
+    float inv_w;
+};
+
+// Per-vertex clip codes: bit p set when outside plane p (near, far, left, right, bottom, top)
+// of the view frustum (`frustum`) and of the guard band (`guard`); `finite` is false for
+// NaN/Inf positions.
+struct VertexCodes {
+    uint8_t frustum;
+    uint8_t guard;
+    bool finite;
+};
+
 // A screen-space triangle ready for coverage. Vertices are ordered so that area2 > 0.
 struct SetupTri {
     int32_t x[3], y[3];   // 24.8 fixed point pixels, y down
@@ -79,6 +96,8 @@ struct GeometryChunk {
 struct GeometryState {
     std::vector<Draw> draws;
     std::vector<ShadeVertex> vertices;  // transformed vertices of every draw
+    std::vector<VertexCodes> codes;     // one per vertex
+    std::vector<ScreenVertex> screen;   // one per vertex; valid where codes.guard == 0
     std::vector<GeometryChunk> chunks;
     glm::vec3 eye{0.0f};  // the eye shading uses (moved by the lens offset)
 
