@@ -92,6 +92,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.eye = st.geometry.eye;
     st.ctx.shade.mode = options.shading;
     st.ctx.shade.filter = options.texture_filter;
+    st.ctx.kernel = selectQuadKernel(options.simd);
     st.ctx.shade.default_light_dir = defaultLightDirection(view);
     st.tile_counters.assign(st.ctx.grid.count(), TileCounters{});
     if (stats) {
@@ -301,6 +302,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     t0 = std::chrono::steady_clock::now();
     const uint32_t cap = desc.max_per_pixel == 0 ? UINT32_MAX : desc.max_per_pixel;
     out.offsets.assign(pixels + 1, 0);
+    out.list_length.assign(pixels, 0);
     std::vector<uint32_t> longest(tiles, 0);
     pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
         const TileRect r = tileRect(st.ctx.grid, tile);
@@ -312,6 +314,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                 for (uint32_t i = st.list_head[p]; i != kNoNode; i = nodes[i].next)
                     ++n;
                 longest[tile] = std::max(longest[tile], n);
+                out.list_length[p] = n;
                 out.offsets[p + 1] = std::min(n, cap);
             }
     });

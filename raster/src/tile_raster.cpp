@@ -1,5 +1,6 @@
 #include "tile_raster.h"
 
+#include "quad_kernel.h"
 #include "sinks.h"
 
 #include <algorithm>
@@ -27,83 +28,70 @@ struct TriangleRaster {
     bool has_colors;  // without vertex colours the colour is exactly white
 };
 
-// Perspective-correct barycentrics from the three edge values of one sample; returns the view
-// distance d = w there (1/w is affine in screen space).
-float barycentrics(const TriangleRaster& tr, const int64_t e[3], float lambda[3], float persp[3]) {
-    float q[3];
-    for (int k = 0; k < 3; ++k) {
-        lambda[k] = float(double(e[k]) * tr.inv_area2);
-        q[k] = lambda[k] * tr.tri->inv_w[k];
-    }
-    const float sum = q[0] + q[1] + q[2];
-    const float inv = sum != 0.0f ? 1.0f / sum : 0.0f;
-    for (int k = 0; k < 3; ++k)
-        persp[k] = q[k] * inv;
-    return inv;
+glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
+    return q.persp[0][l] * tr.v[0]->uv + q.persp[1][l] * tr.v[1]->uv + q.persp[2][l] * tr.v[2]->uv;
 }
 
-glm::vec2 interpolateUv(const TriangleRaster& tr, const float b[3]) {
-    return b[0] * tr.v[0]->uv + b[1] * tr.v[1]->uv + b[2] * tr.v[2]->uv;
-}
-
-// One 2x2 quad at (qx, qy) (even coordinates). `e` holds the edge values at its top-left pixel.
+// Two 2x2 quads at (qx, qy) and (qx + 2, qy) (qx a multiple of 4, qy even): the quad kernel finds
+// coverage, barycentrics and depth for the 8 pixels at once; the covered ones are then shaded and
+// handed to the sink one by one, in lane order.
 template <class Sink>
-void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, int32_t qy,
-               const int64_t e[3], Sink& sink, TileCounters& counters) {
+void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, int32_t qy,
+                   Sink& sink, TileCounters& counters) {
     const SetupTri& t = *tr.tri;
-    const int64_t step_x[3] = {tr.edges[0].a * kSubpixelOne, tr.edges[1].a * kSubpixelOne,
-                               tr.edges[2].a * kSubpixelOne};
-    const int64_t step_y[3] = {tr.edges[0].b * kSubpixelOne, tr.edges[1].b * kSubpixelOne,
-                               tr.edges[2].b * kSubpixelOne};
-    int64_t pe[4][3];
-    uint32_t mask = 0;
-    for (int p = 0; p < 4; ++p) {
-        const int dx = p & 1, dy = p >> 1;
-        bool inside = qx + dx < int32_t(ctx.grid.width) && qy + dy < int32_t(ctx.grid.height);
-        for (int k = 0; k < 3; ++k) {
-            pe[p][k] = e[k] + dx * step_x[k] + dy * step_y[k];
-            inside = inside && pe[p][k] + tr.edges[k].bias >= 0;
-        }
-        mask |= uint32_t(inside) << p;
+    QuadInput in;
+    for (int k = 0; k < 3; ++k) {
+        const Edge& e = tr.edges[k];
+        in.edge[k] = double(e.at(centre(qx), centre(qy)));
+        in.step_x[k] = double(e.a * kSubpixelOne);
+        in.step_y[k] = double(e.b * kSubpixelOne);
+        in.bias[k] = double(e.bias);
+        in.inv_w[k] = t.inv_w[k];
+        in.z[k] = t.z[k];
     }
-    if (mask == 0)
+    in.inv_area2 = tr.inv_area2;
+    in.valid = 0;
+    for (int l = 0; l < kQuadLanes; ++l) {
+        const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
+        in.valid |= uint32_t(x < int32_t(ctx.grid.width) && y < int32_t(ctx.grid.height)) << l;
+    }
+    QuadOutput q;
+    ctx.kernel(in, q);
+    if (q.mask == 0)
         return;
 
-    // Interpolate the whole quad (helper pixels included) so uv derivatives exist.
-    float lambda[4][3], persp[4][3], distance[4];
-    for (int p = 0; p < 4; ++p)
-        distance[p] = barycentrics(tr, pe[p], lambda[p], persp[p]);
     const Material& m = *tr.material;
     const bool textured = m.base_color_texture.image >= 0 || m.emissive_texture.image >= 0;
-    UvFootprint quad_uv[4];
+    UvFootprint lane_uv[kQuadLanes];
     if (textured) {
-        glm::vec2 uv[4];
-        for (int p = 0; p < 4; ++p)
-            uv[p] = interpolateUv(tr, persp[p]);
-        // Coarse derivatives, one pair per quad (as GPUs' ddx/ddy).
-        const glm::vec2 ddx = uv[1] - uv[0], ddy = uv[2] - uv[0];
-        for (int p = 0; p < 4; ++p)
-            quad_uv[p] = {uv[p], ddx, ddy};
+        // Every lane is interpolated (helper pixels included) so each quad has coarse
+        // derivatives, one pair per quad (as GPUs' ddx/ddy).
+        glm::vec2 uv[kQuadLanes];
+        for (int l = 0; l < kQuadLanes; ++l)
+            uv[l] = interpolateUv(tr, q, l);
+        for (int l = 0; l < kQuadLanes; ++l) {
+            const int base = l & ~3;
+            lane_uv[l] = {uv[l], uv[base + 1] - uv[base], uv[base + 2] - uv[base]};
+        }
     }
 
-    for (int p = 0; p < 4; ++p) {
-        if (!(mask & (1u << p)))
+    for (int l = 0; l < kQuadLanes; ++l) {
+        if (!(q.mask & (1u << l)))
             continue;
         ++counters.covered;
-        const int32_t x = qx + (p & 1), y = qy + (p >> 1);
+        const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
         const size_t idx = size_t(y) * ctx.grid.width + size_t(x);
-        const float* l = lambda[p];
         Fragment frag;
-        frag.z = std::clamp(l[0] * t.z[0] + l[1] * t.z[1] + l[2] * t.z[2], 0.0f, 1.0f);
-        frag.distance = distance[p];
+        frag.z = q.z[l];
+        frag.distance = q.distance[l];
         // Early depth test: legal because this tile's owner is the only writer of the pixel.
         if (!sink.test(idx, frag.z, frag.distance))
             continue;
-        const float* b = persp[p];
+        const float b[3] = {q.persp[0][l], q.persp[1][l], q.persp[2][l]};
         const glm::vec4 vcolor =
             tr.has_colors ? b[0] * tr.v[0]->color + b[1] * tr.v[1]->color + b[2] * tr.v[2]->color
                           : glm::vec4(1.0f);
-        const glm::vec4 base = baseColor(ctx.shade, m, quad_uv[p], vcolor);
+        const glm::vec4 base = baseColor(ctx.shade, m, lane_uv[l], vcolor);
         if (m.alpha_mode == AlphaMode::Mask && !(base.a >= m.alpha_cutoff))
             continue;
         ++counters.passed;
@@ -115,12 +103,12 @@ void shadeQuad(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, i
             if (!t.front_facing)
                 normal = -normal;  // glTF: back faces of double-sided materials flip the normal
         }
-        const glm::vec3 rgb = shadeColor(ctx.shade, m, quad_uv[p], base, world, normal);
+        const glm::vec3 rgb = shadeColor(ctx.shade, m, lane_uv[l], base, world, normal);
         frag.blend = m.alpha_mode == AlphaMode::Blend;
         frag.color = glm::vec4(rgb, frag.blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f);
         frag.primitive_id = t.primitive_id;
         if (sink.wants_gbuffer)
-            frag.g = surfaceSample(ctx.shade, m, quad_uv[p], base, normal);
+            frag.g = surfaceSample(ctx.shade, m, lane_uv[l], base, normal);
         sink.write(idx, frag);
     }
 }
@@ -146,8 +134,8 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
         tr.face_normal = -tr.face_normal;
     sink.beginTriangle(t);
 
-    // Pixel range of this triangle in this tile, widened to whole quads.
-    const int32_t x0 = std::max(t.min_x, tile_x0) & ~1, y0 = std::max(t.min_y, tile_y0) & ~1;
+    // Pixel range of this triangle in this tile, widened to whole quad pairs.
+    const int32_t x0 = std::max(t.min_x, tile_x0) & ~3, y0 = std::max(t.min_y, tile_y0) & ~1;
     const int32_t x1 = std::min(t.max_x, tile_x1), y1 = std::min(t.max_y, tile_y1);
     for (int32_t by = y0; by <= y1; by += kBlockSize - (by % kBlockSize)) {
         const int32_t by1 = std::min(by + kBlockSize - 1 - (by % kBlockSize), y1);
@@ -163,16 +151,9 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
             }
             if (reject)
                 continue;
-            for (int32_t qy = by; qy <= by1; qy += 2) {
-                int64_t e[3];
-                for (int k = 0; k < 3; ++k)
-                    e[k] = tr.edges[k].at(centre(bx), centre(qy));
-                for (int32_t qx = bx; qx <= bx1; qx += 2) {
-                    shadeQuad(ctx, tr, qx, qy, e, sink, counters);
-                    for (int k = 0; k < 3; ++k)
-                        e[k] += 2 * tr.edges[k].a * kSubpixelOne;
-                }
-            }
+            for (int32_t qy = by; qy <= by1; qy += 2)
+                for (int32_t qx = bx; qx <= bx1; qx += 4)
+                    shadeQuadPair(ctx, tr, qx, qy, sink, counters);
         }
     }
 }

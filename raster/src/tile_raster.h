@@ -7,6 +7,7 @@
 
 #include "binning.h"
 #include "geometry.h"
+#include "quad_kernel.h"
 #include "shading.h"
 
 #include <raster/layered_target.h>
@@ -21,6 +22,7 @@ struct RasterContext {
     const std::vector<ChunkBins>* bins = nullptr;
     TileGrid grid;
     ShadeContext shade;
+    QuadKernel kernel = &quadKernelScalar;
 };
 
 struct TileCounters {

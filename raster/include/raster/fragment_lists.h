@@ -37,6 +37,7 @@ struct FragmentLists {
     ColorBuffer color;     // linear RGB + opacity (alpha), one per fragment
     DepthBuffer depth;     // stored depth D, one per fragment (width = count, height = 1)
     std::vector<uint32_t> primitive;  // submission index of the fragment's triangle
+    std::vector<uint32_t> list_length;  // per pixel: fragments collected before the cap
 
     // Counts from the collection pass.
     uint64_t fragments_collected = 0;  // nodes appended (all fragments)
@@ -47,7 +48,8 @@ struct FragmentLists {
 
     uint32_t count(size_t pixel) const { return offsets[pixel + 1] - offsets[pixel]; }
     size_t bytes() const {
-        return offsets.size() * 4 + color.bytes() + depth.bytes() + primitive.size() * 4;
+        return (offsets.size() + primitive.size() + list_length.size()) * 4 + color.bytes() +
+               depth.bytes();
     }
 };
 

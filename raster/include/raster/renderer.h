@@ -29,6 +29,8 @@ struct RenderOptions {
     DepthFormat depth_format = DepthFormat::Float32;
     ShadingMode shading = ShadingMode::Material;
     FilterOverride texture_filter = FilterOverride::Sampler;
+    // Use the SIMD kernels when the CPU has them (same bits); false runs the scalar reference.
+    bool simd = true;
     // Depth peeling (Everitt 2001), for Renderer::render only: when set, fragments whose stored
     // depth is not strictly behind this buffer's value (same size and format as the frame's) are
     // discarded, so repeated renders peel the scene front to back.

@@ -1,0 +1,44 @@
+// The SIMD kernel of the tile raster: coverage, barycentrics, perspective correction and depth
+// for a pair of 2x2 quads (8 pixels) at once. Written once (quad_kernel.inl) as lane loops and
+// compiled twice: plain (the scalar reference, always built) and with AVX2 (quad_kernel_avx2.cpp),
+// chosen at run time. Edge functions are integers below 2^50 (geometry.h), exact in double, and
+// the build never contracts a*b+c into an FMA, so both variants produce the same bits
+// (tests/unit/raster/simd_test.cpp).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace raster {
+
+constexpr int kQuadLanes = 8;  // two horizontally adjacent 2x2 quads; lane = quad*4 + dy*2 + dx
+
+struct QuadInput {
+    double edge[3];    // edge function values at the first pixel centre (exact integers)
+    double step_x[3];  // change of each edge function per pixel in x
+    double step_y[3];  // per pixel in y
+    double bias[3];    // 0 or -1: the top-left rule
+    double inv_area2;  // 1 / (2 * area)
+    float inv_w[3];    // per vertex
+    float z[3];        // stored depth D per vertex
+    uint32_t valid;    // lanes inside the viewport
+};
+
+struct QuadOutput {
+    uint32_t mask;              // covered lanes
+    float lambda[3][kQuadLanes];  // screen-space barycentrics
+    float persp[3][kQuadLanes];   // perspective-correct barycentrics
+    float distance[kQuadLanes];   // view distance d = w
+    float z[kQuadLanes];          // stored depth D, clamped to [0, 1]
+};
+
+using QuadKernel = void (*)(const QuadInput&, QuadOutput&);
+
+void quadKernelScalar(const QuadInput& in, QuadOutput& out);
+// The AVX2 build of the same kernel; nullptr when not compiled in (FOCAL_NO_SIMD).
+QuadKernel quadKernelAvx2();
+// The fastest kernel this CPU runs, or the scalar reference when `simd` is false.
+QuadKernel selectQuadKernel(bool simd);
+
+}  // namespace raster
