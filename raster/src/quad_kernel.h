@@ -6,8 +6,6 @@
 // (tests/unit/raster/simd_test.cpp).
 #pragma once
 
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
 
 namespace raster {

@@ -1,7 +1,8 @@
 // Body of the quad kernel (quad_kernel.h); included by quad_kernel.cpp and
 // quad_kernel_avx2.cpp with different instruction sets. Branch-free lane loops over fixed-size
 // arrays, so the compiler vectorizes them; every lane does the same IEEE operations in the same
-// order as in the scalar build.
+// order as in the scalar build. No calls to inline library templates here: the AVX2 copy of such
+// a template could be the one the linker keeps for the whole program.
 #ifndef FOCAL_QUAD_KERNEL_NAME
 #error "define FOCAL_QUAD_KERNEL_NAME before including quad_kernel.inl"
 #endif
@@ -41,6 +42,6 @@ void FOCAL_QUAD_KERNEL_NAME(const QuadInput& in, QuadOutput& out) {
         out.persp[1][l] = q1 * inv;
         out.persp[2][l] = q2 * inv;
         out.distance[l] = inv;
-        out.z[l] = std::min(std::max(z, 0.0f), 1.0f);  // (z < 0 ? 0 : z), then (1 < z ? 1 : z)
+        out.z[l] = z < 0.0f ? 0.0f : (z > 1.0f ? 1.0f : z);
     }
 }

@@ -4,6 +4,7 @@
 
 #include "binning.h"
 #include "geometry.h"
+#include "light_kernel.h"
 #include "sinks.h"
 #include "tile_raster.h"
 
@@ -21,6 +22,7 @@ struct Renderer::State {
     GeometryState geometry;
     std::vector<ChunkBins> bins;
     RasterContext ctx;
+    std::vector<PreparedLight> lights;
     std::vector<TileCounters> tile_counters;
     // Fragment-list collection: head per pixel, one node pool per tile, sort scratch per worker.
     std::vector<uint32_t> list_head;
@@ -93,7 +95,10 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.mode = options.shading;
     st.ctx.shade.filter = options.texture_filter;
     st.ctx.kernel = selectQuadKernel(options.simd);
-    st.ctx.shade.default_light_dir = defaultLightDirection(view);
+    st.lights = prepareLights(scene, defaultLightDirection(view));
+    st.ctx.shade.lights = st.lights.data();
+    st.ctx.shade.light_count = uint32_t(st.lights.size());
+    st.ctx.shade.light_kernel = selectLightKernel(options.simd);
     st.tile_counters.assign(st.ctx.grid.count(), TileCounters{});
     if (stats) {
         *stats = FrameStats{};

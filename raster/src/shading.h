@@ -4,6 +4,8 @@
 // Consumes the Scene's materials and images (read-only); stateless.
 #pragma once
 
+#include "light_kernel.h"
+
 #include <raster/layered_target.h>
 #include <raster/renderer.h>
 #include <raster/scene.h>
@@ -18,9 +20,11 @@ namespace raster {
 struct ShadeContext {
     const Scene* scene = nullptr;
     glm::vec3 eye{0.0f};
-    glm::vec3 default_light_dir{0.0f, -1.0f, 0.0f};  // used when the scene has no lights
     ShadingMode mode = ShadingMode::Material;
     FilterOverride filter = FilterOverride::Sampler;
+    const PreparedLight* lights = nullptr;  // prepareLights(): the scene's or the default light
+    uint32_t light_count = 0;
+    LightKernel light_kernel = &lightKernelScalar;
 };
 
 // Texture coordinates and their screen derivatives (from the 2x2 quad) at one fragment.
@@ -34,17 +38,18 @@ struct UvFootprint {
 glm::vec4 baseColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
                     glm::vec4 vertex_color);
 
-// Final linear RGB for a fragment with base colour `base`; `normal` faces the viewer side the
-// fragment is seen from (unnormalised is fine).
-glm::vec3 shadeColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
-                     glm::vec4 base, glm::vec3 world, glm::vec3 normal);
+// Emissive radiance: factor x emissive texture.
+glm::vec3 emissiveColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv);
+
+// Whether fragments of `m` skip lighting (KHR_materials_unlit or --shading unlit).
+bool isUnlit(const ShadeContext& ctx, const Material& m);
 
 // The surface parameters a G-buffer keeps so a hit can be re-shaded from another view
 // direction (Lee et al. 2009 §5): unit normal, albedo, metallic, roughness, emissive.
 GSample surfaceSample(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
                       glm::vec4 base, glm::vec3 normal);
 
-// Shades a G-buffer sample at `world` as seen from `eye` (same model as shadeColor).
+// Shades a G-buffer sample at `world` as seen from `eye` (the same lighting kernel as fragments).
 glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world, glm::vec3 eye);
 
 }  // namespace raster

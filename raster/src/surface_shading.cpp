@@ -1,6 +1,9 @@
 #include <raster/surface_shading.h>
 
+#include "light_kernel.h"
 #include "shading.h"
+
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -10,13 +13,26 @@ glm::vec3 defaultLightDirection(const View& view) {
     return glm::normalize(0.35f * view.right - 0.6f * view.up + 0.7f * view.forward);
 }
 
-glm::vec3 shadeSurface(const Scene& scene, const View& view, const GSample& g, glm::vec3 world,
-                       glm::vec3 eye) {
+struct SurfaceShader::Impl {
+    std::vector<PreparedLight> lights;
     ShadeContext ctx;
-    ctx.scene = &scene;
-    ctx.eye = eye;
-    ctx.default_light_dir = defaultLightDirection(view);
-    return shadeSample(ctx, g, world, eye);
+};
+
+SurfaceShader::SurfaceShader(const Scene& scene, const View& view, bool simd)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->lights = prepareLights(scene, defaultLightDirection(view));
+    impl_->ctx.scene = &scene;
+    impl_->ctx.lights = impl_->lights.data();
+    impl_->ctx.light_count = uint32_t(impl_->lights.size());
+    impl_->ctx.light_kernel = selectLightKernel(simd);
+}
+
+SurfaceShader::~SurfaceShader() = default;
+SurfaceShader::SurfaceShader(SurfaceShader&&) noexcept = default;
+SurfaceShader& SurfaceShader::operator=(SurfaceShader&&) noexcept = default;
+
+glm::vec3 SurfaceShader::shade(const GSample& g, glm::vec3 world, glm::vec3 eye) const {
+    return shadeSample(impl_->ctx, g, world, eye);
 }
 
 }  // namespace raster

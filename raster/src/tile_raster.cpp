@@ -75,13 +75,20 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         }
     }
 
+    // Per covered lane: early depth test, base colour, alpha test. Lanes are distinct pixels,
+    // so testing them all before any is written is the same as one at a time.
+    Fragment frags[kQuadLanes];
+    int lane_of[kQuadLanes];
+    glm::vec3 normals[kQuadLanes];
+    int active = 0;
+    LightLanes light;
     for (int l = 0; l < kQuadLanes; ++l) {
         if (!(q.mask & (1u << l)))
             continue;
         ++counters.covered;
         const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
         const size_t idx = size_t(y) * ctx.grid.width + size_t(x);
-        Fragment frag;
+        Fragment& frag = frags[active];
         frag.z = q.z[l];
         frag.distance = q.distance[l];
         // Early depth test: legal because this tile's owner is the only writer of the pixel.
@@ -103,13 +110,40 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
             if (!t.front_facing)
                 normal = -normal;  // glTF: back faces of double-sided materials flip the normal
         }
-        const glm::vec3 rgb = shadeColor(ctx.shade, m, lane_uv[l], base, world, normal);
+        const glm::vec3 emissive = emissiveColor(ctx.shade, m, lane_uv[l]);
+        for (int c = 0; c < 3; ++c) {
+            light.albedo[c][active] = base[c];
+            light.emissive[c][active] = emissive[c];
+            light.world[c][active] = world[c];
+            light.normal[c][active] = normal[c];
+        }
         frag.blend = m.alpha_mode == AlphaMode::Blend;
-        frag.color = glm::vec4(rgb, frag.blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f);
+        frag.color.a = frag.blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f;
         frag.primitive_id = t.primitive_id;
-        if (sink.wants_gbuffer)
-            frag.g = surfaceSample(ctx.shade, m, lane_uv[l], base, normal);
-        sink.write(idx, frag);
+        normals[active] = normal;
+        lane_of[active++] = l;
+    }
+    if (active == 0)
+        return;
+
+    // Shade the surviving lanes together (the lighting kernel), then hand them to the sink.
+    const bool unlit = isUnlit(ctx.shade, m);
+    if (!unlit) {
+        const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
+        ctx.shade.light_kernel(ctx.shade.lights, ctx.shade.light_count,
+                               {m.metallic_factor, m.roughness_factor}, eye, light, active);
+    }
+    for (int i = 0; i < active; ++i) {
+        const int l = lane_of[i];
+        const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
+        Fragment& frag = frags[i];
+        for (int c = 0; c < 3; ++c)
+            frag.color[c] = unlit ? light.albedo[c][i] + light.emissive[c][i] : light.rgb[c][i];
+        if (sink.wants_gbuffer) {
+            const glm::vec4 base(light.albedo[0][i], light.albedo[1][i], light.albedo[2][i], 1.0f);
+            frag.g = surfaceSample(ctx.shade, m, lane_uv[l], base, normals[i]);
+        }
+        sink.write(size_t(y) * ctx.grid.width + size_t(x), frag);
     }
 }
 

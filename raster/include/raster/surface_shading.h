@@ -1,23 +1,36 @@
 // Re-shading a stored surface sample (a G-buffer texel) from any eye position, with the same
-// model the rasterizer shades fragments with: Lambert + energy-normalised Blinn-Phong over the
-// scene's punctual lights (or the default light of `view`), constant ambient, emissive.
-// Used by methods that shade per lens ray (Lee et al. 2009 §5). Reads the Scene; stateless.
+// lighting kernel the rasterizer shades fragments with: Lambert + energy-normalised Blinn-Phong
+// over the scene's punctual lights (or the default light of the view), constant ambient,
+// emissive. Used by methods that shade per lens ray (Lee et al. 2009 §5).
 #pragma once
 
 #include <raster/camera.h>
 #include <raster/layered_target.h>
-#include <raster/renderer.h>
 #include <raster/scene.h>
+
+#include <memory>
 
 #include <glm/vec3.hpp>
 
 namespace raster {
 
-// Linear RGB leaving `world` towards `eye` for the surface `g` (g.unlit: base colour+emissive;
-// the shading mode was applied when the sample was written).
-// `view` supplies the default light when the scene has none (as Renderer::render does).
-glm::vec3 shadeSurface(const Scene& scene, const View& view, const GSample& g, glm::vec3 world,
-                       glm::vec3 eye);
+// Prepared once per frame (lights, kernel choice); shade() is thread-safe and allocation-free.
+// The Scene must outlive it.
+class SurfaceShader {
+public:
+    SurfaceShader(const Scene& scene, const View& view, bool simd = true);
+    ~SurfaceShader();
+    SurfaceShader(SurfaceShader&&) noexcept;
+    SurfaceShader& operator=(SurfaceShader&&) noexcept;
+
+    // Linear RGB leaving `world` towards `eye` for the surface `g` (g.unlit: base colour +
+    // emissive; the shading mode was applied when the sample was written).
+    glm::vec3 shade(const GSample& g, glm::vec3 world, glm::vec3 eye) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 // The direction of travel of the default light for `view` (from above-left, behind the viewer).
 glm::vec3 defaultLightDirection(const View& view);
