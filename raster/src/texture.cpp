@@ -34,16 +34,21 @@ uint8_t encode8(float v, bool srgb) {
     return uint8_t(c * 255.0f + 0.5f);
 }
 
-glm::vec4 fetch(const MipLevel& level, bool srgb, int x, int y) {
+// Linear RGBA of texel (x, y); `lut` decodes sRGB colour channels (nullptr: linear image).
+inline glm::vec4 fetch(const MipLevel& level, const float* lut, int x, int y) {
     const uint8_t* t = &level.rgba8[(size_t(y) * level.width + size_t(x)) * 4];
-    if (srgb) {
-        const std::array<float, 256>& lut = srgbTable();
+    if (lut)
         return {lut[t[0]], lut[t[1]], lut[t[2]], float(t[3]) * (1.0f / 255.0f)};
-    }
     return glm::vec4(t[0], t[1], t[2], t[3]) * (1.0f / 255.0f);
 }
 
+glm::vec4 fetch(const MipLevel& level, bool srgb, int x, int y) {
+    return fetch(level, srgb ? srgbTable().data() : nullptr, x, y);
+}
+
 int wrapIndex(int64_t i, int n, Wrap wrap) {
+    if (i >= 0 && i < n)  // inside: every mode agrees, and it is by far the common case
+        return int(i);
     switch (wrap) {
     case Wrap::Repeat:
         return int(((i % n) + n) % n);
@@ -66,19 +71,19 @@ double texelCoord(float u, uint32_t size) {
 glm::vec4 sampleLevel(const Image& image, const MipLevel& level, const Sampler& s, Filter filter,
                       glm::vec2 uv) {
     const int w = int(level.width), h = int(level.height);
+    const float* lut = image.srgb ? srgbTable().data() : nullptr;
     const double x = texelCoord(uv.x, level.width);
     const double y = texelCoord(uv.y, level.height);
     if (filter == Filter::Nearest) {
         const int64_t ix = int64_t(std::floor(x + 0.5)), iy = int64_t(std::floor(y + 0.5));
-        return fetch(level, image.srgb, wrapIndex(ix, w, s.wrap_s), wrapIndex(iy, h, s.wrap_t));
+        return fetch(level, lut, wrapIndex(ix, w, s.wrap_s), wrapIndex(iy, h, s.wrap_t));
     }
     const double fx = std::floor(x), fy = std::floor(y);
     const float ax = float(x - fx), ay = float(y - fy);
     const int x0 = wrapIndex(int64_t(fx), w, s.wrap_s), x1 = wrapIndex(int64_t(fx) + 1, w, s.wrap_s);
     const int y0 = wrapIndex(int64_t(fy), h, s.wrap_t), y1 = wrapIndex(int64_t(fy) + 1, h, s.wrap_t);
-    const glm::vec4 top = glm::mix(fetch(level, image.srgb, x0, y0), fetch(level, image.srgb, x1, y0), ax);
-    const glm::vec4 bottom =
-        glm::mix(fetch(level, image.srgb, x0, y1), fetch(level, image.srgb, x1, y1), ax);
+    const glm::vec4 top = glm::mix(fetch(level, lut, x0, y0), fetch(level, lut, x1, y0), ax);
+    const glm::vec4 bottom = glm::mix(fetch(level, lut, x0, y1), fetch(level, lut, x1, y1), ax);
     return glm::mix(top, bottom, ay);
 }
 
