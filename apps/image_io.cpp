@@ -37,8 +37,8 @@ Status writeDirect(const std::string& path, const std::string& format_hint_path,
                    const ImageData& image) {
     auto out = OIIO::ImageOutput::create(format_hint_path);
     if (!out)
-        return Status::error(format_hint_path + ": cannot write this image format (" +
-                             oneLine(OIIO::geterror()) + ")");
+        return Status::error("cannot write this image format (" + oneLine(OIIO::geterror()) +
+                             ")");
     const bool linear = isLinearFormat(format_hint_path);
     OIIO::ImageSpec spec(int(image.width), int(image.height), int(image.channels),
                          linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);

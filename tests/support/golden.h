@@ -1,0 +1,68 @@
+// Golden references for the full test tier (docs/testing.md): consumes a rendered Frame and a
+// case name; compares its hash exactly against tests/golden/hashes.txt and its 8-bit sRGB image
+// against tests/golden/images/NAME.png within 1 LSB per channel. On a mismatch it writes
+// NAME_actual.png and NAME_diff.png to goldenDiffDir() and names them in the failure message.
+// With FOCAL_UPDATE_GOLDENS=1 in the environment it rewrites the hash line and the image instead.
+#pragma once
+
+#include <raster/frame.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace focal::test {
+
+// The largest per-channel difference, in 8-bit sRGB steps, the image check accepts (the hash
+// check accepts none). One step absorbs 8-bit rounding of a colour that moved by a hair.
+inline constexpr int kGoldenImageTolerance = 1;
+
+// The command that regenerates every golden (printed in failure messages).
+inline constexpr const char* kGoldenUpdateCommand =
+    "FOCAL_UPDATE_GOLDENS=1 ctest --preset release -L full";
+
+// True when FOCAL_UPDATE_GOLDENS is set to anything but "" or "0".
+bool updatingGoldens();
+
+// <source>/tests/golden, its hashes.txt and images/NAME.png.
+std::filesystem::path goldenDir();
+std::filesystem::path goldenHashFile();
+std::filesystem::path goldenImagePath(const std::string& name);
+// Where mismatches are written: $FOCAL_GOLDEN_DIFF_DIR, else <working dir>/golden-diff (CTest
+// runs the tests in <build>/tests, so <build>/tests/golden-diff). Created on demand.
+std::filesystem::path goldenDiffDir();
+
+// Reads "NAME HEX16" lines ('#' starts a comment). A missing file reads as empty; a malformed
+// line adds a message to *errors.
+std::map<std::string, uint64_t> readGoldenHashes(const std::filesystem::path& file,
+                                                 std::vector<std::string>* errors = nullptr);
+
+// Under a machine-wide lock (CTest may run cases in parallel), applies `set` and removes every
+// name in `remove`, then rewrites the file atomically, sorted by name.
+void updateGoldenHashes(const std::filesystem::path& file,
+                        const std::map<std::string, uint64_t>& set,
+                        const std::vector<std::string>& remove = {});
+
+// The frame's colour as the PNG writer encodes it (apps/image_io.cpp): RGB sRGB-encoded, alpha
+// linear, clamped to [0,1] and rounded to 8 bits. RGBA, top row first.
+std::vector<uint8_t> toSrgb8(const raster::Frame& frame);
+
+// Reads an 8-bit RGBA PNG as its exact bytes. False, with a message, when it is missing,
+// unreadable or not RGBA.
+bool readPngRgba8(const std::filesystem::path& path, uint32_t& width, uint32_t& height,
+                  std::vector<uint8_t>& rgba, std::string& error);
+
+// Compares `frame` with the golden called `name` (see the top of this file), or updates it.
+::testing::AssertionResult matchesGolden(const std::string& name, const raster::Frame& frame);
+
+// For two renders that should have been identical: writes NAME_actual.png (from `actual`) and
+// NAME_diff.png (against `expected`) to goldenDiffDir(); returns lines describing the
+// difference and naming both files.
+std::string describeFrameDifference(const std::string& name, const raster::Frame& expected,
+                                    const raster::Frame& actual);
+
+} // namespace focal::test
