@@ -1,12 +1,13 @@
 #include "apps/cli.h"
 
+#include "apps/compare_command.h"
 #include "apps/render_command.h"
 #include "apps/scene_info.h"
 #include "apps/scene_source.h"
 
-#include <cstdio>
-
 #include <CLI/CLI.hpp>
+
+#include <cstdio>
 
 namespace focal {
 
@@ -22,7 +23,7 @@ int runInfo(const std::string& spec) {
     return 0;
 }
 
-}  // namespace
+} // namespace
 
 int runCli(int argc, char** argv) {
     CLI::App app{"focal: a deterministic CPU rasterizer for depth-of-field research"};
@@ -31,6 +32,9 @@ int runCli(int argc, char** argv) {
 
     RenderArgs render_args;
     CLI::App* render = addRenderCommand(app, render_args);
+
+    CompareArgs compare_args;
+    CLI::App* compare = addCompareCommand(app, compare_args);
 
     std::string info_scene;
     CLI::App* info = app.add_subcommand("info", "Describe a scene: triangles, meshes, materials, "
@@ -51,9 +55,11 @@ int runCli(int argc, char** argv) {
     }
     if (render->parsed())
         return runRender(render_args);
+    if (compare->parsed())
+        return runCompare(compare_args);
     if (info->parsed())
         return runInfo(info_scene);
     return 2;
 }
 
-}  // namespace focal
+} // namespace focal

@@ -1,12 +1,19 @@
 #include "apps/render_command.h"
 
+#include "apps/dof_method.h"
 #include "apps/image_io.h"
 #include "apps/scene_source.h"
 #include "apps/text_file.h"
 
+#include <dof/accum.h>
+#include <dof/lens.h>
+#include <dof/lens_samples.h>
 #include <raster/camera.h>
 #include <raster/renderer.h>
 #include <raster/task_pool.h>
+
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -14,9 +21,7 @@
 #include <cstdio>
 #include <sstream>
 #include <thread>
-
-#include <glm/geometric.hpp>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 namespace focal {
 
@@ -100,14 +105,131 @@ int fail(const std::string& message) {
     return 1;
 }
 
-}  // namespace
+Result<glm::uvec2> parsePixel(const std::string& option, const std::string& text) {
+    long long x = -1, y = -1;
+    char comma = 0;
+    std::istringstream in(text);
+    in >> x >> comma >> y;
+    if (!in || comma != ',' || !(in >> std::ws).eof() || x < 0 || y < 0 || x > 1000000 ||
+        y > 1000000)
+        return Status::error(option + " expects a pixel X,Y (integers >= 0), got '" + text + "'");
+    return glm::uvec2(uint32_t(x), uint32_t(y));
+}
+
+Status checkPositive(const char* option, const std::optional<float>& v, bool allow_zero) {
+    if (v && (!std::isfinite(*v) || *v < 0.0f || (!allow_zero && *v == 0.0f)))
+        return Status::error(std::string(option) + " must be a finite number " +
+                             (allow_zero ? ">= 0" : "> 0") + ", got " + std::to_string(*v));
+    return {};
+}
+
+// Everything the lens resolution decided, for the stats file.
+struct LensChoice {
+    dof::ThinLens lens;
+    std::string aperture_source = "default"; // cli | fstop | scene | default
+    std::string focus_source = "view";       // cli | focus-pixel | target | scene | autofocus
+                                             // | bounds | view
+    double ms_focus = 0.0;                   // pinhole render(s) needed to choose the focus
+};
+
+dof::LensPattern patternOf(const std::string& name) {
+    return name == "halton"    ? dof::LensPattern::Halton
+           : name == "poisson" ? dof::LensPattern::Poisson
+                               : dof::LensPattern::Hammersley;
+}
+
+Result<dof::ApertureShape> resolveAperture(const RenderArgs& args) {
+    dof::ApertureShape shape;
+    std::string kind = args.aperture_shape.value_or(
+        !args.aperture_image.empty() ? "image" : (args.aperture_blades ? "polygon" : "circle"));
+    if (kind == "polygon") {
+        shape.kind = dof::ApertureKind::Polygon;
+        shape.blades = args.aperture_blades.value_or(6);
+        shape.rotation_deg = args.aperture_rotation_deg;
+    } else if (kind == "image") {
+        if (args.aperture_image.empty())
+            return Status::error("--aperture-shape image needs --aperture-image FILE");
+        Result<ImageData> img = readImage(args.aperture_image);
+        if (!img.ok())
+            return img.status();
+        // Transmission: mean of RGB (or grey) in linear light, times alpha when present.
+        shape.kind = dof::ApertureKind::Image;
+        shape.mask.width = img->width;
+        shape.mask.height = img->height;
+        const uint32_t ch = img->channels;
+        shape.mask.transmission.resize(size_t(img->width) * img->height);
+        for (size_t i = 0; i < shape.mask.transmission.size(); ++i) {
+            const float* p = &img->pixels[i * ch];
+            float t = ch >= 3 ? (p[0] + p[1] + p[2]) / 3.0f : p[0];
+            if (ch == 2 || ch == 4)
+                t *= p[ch - 1];
+            shape.mask.transmission[i] = std::max(t, 0.0f);
+        }
+    } else if (kind != "circle") {
+        return Status::error("unknown --aperture-shape " + kind);
+    }
+    if (kind != "polygon" && args.aperture_blades)
+        return Status::error("--aperture-blades needs --aperture-shape polygon");
+    if (kind != "image" && !args.aperture_image.empty())
+        return Status::error("--aperture-image needs --aperture-shape image");
+    return shape;
+}
+
+const char* apertureKindName(dof::ApertureKind k) {
+    return k == dof::ApertureKind::Polygon ? "polygon"
+           : k == dof::ApertureKind::Image ? "image"
+                                           : "circle";
+}
+
+std::vector<std::string> methodNames() {
+    std::vector<std::string> names = {"pinhole", "accum"};
+    for (const MethodEntry& m : methodTable())
+        names.push_back(m.name);
+    return names;
+}
+
+const MethodEntry* findMethod(const std::string& name) {
+    for (const MethodEntry& m : methodTable())
+        if (m.name == name)
+            return &m;
+    return nullptr;
+}
+
+// Progress bar on stderr, only when stderr is a terminal.
+class ProgressBar {
+public:
+    explicit ProgressBar(bool enabled) : enabled_(enabled) {}
+    void update(uint32_t done, uint32_t total) {
+        if (!enabled_ || total == 0)
+            return;
+        const uint32_t permille = uint32_t(uint64_t(done) * 1000 / total);
+        if (permille == last_ && done != total)
+            return;
+        last_ = permille;
+        constexpr int kBar = 40;
+        const int filled = int(uint64_t(done) * kBar / total);
+        std::fprintf(stderr, "\rfocal: accum [%.*s%.*s] %u/%u views", filled,
+                     "########################################", kBar - filled,
+                     "........................................", done, total);
+        if (done == total)
+            std::fputc('\n', stderr);
+        std::fflush(stderr);
+    }
+
+private:
+    bool enabled_;
+    uint32_t last_ = ~0u;
+};
+
+} // namespace
 
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     CLI::App* cmd = app.add_subcommand("render", "Render a scene to an image");
     args.threads = std::max(1u, std::thread::hardware_concurrency());
     cmd->add_option("scene", args.scene, "glTF file (.gltf/.glb) or builtin:NAME")->required();
-    cmd->add_option("-o,--output", args.output, "output image: .exr (linear float RGBA) or .png "
-                                                "(8-bit sRGB)")
+    cmd->add_option("-o,--output", args.output,
+                    "output image: .exr (linear float RGBA) or .png "
+                    "(8-bit sRGB)")
         ->required();
     cmd->add_option("--width", args.width, "image width in pixels")
         ->capture_default_str()
@@ -119,8 +241,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--eye", args.eye, "camera position X,Y,Z (world units)");
     cmd->add_option("--target", args.target, "point looked at X,Y,Z (world units)");
     cmd->add_option("--up", args.up, "up direction X,Y,Z [default: 0,1,0]");
-    cmd->add_option("--yfov", args.yfov_deg, "vertical field of view in degrees [default: the "
-                                             "camera's, or 45]")
+    cmd->add_option("--yfov", args.yfov_deg,
+                    "vertical field of view in degrees [default: the "
+                    "camera's, or 45]")
         ->check(CLI::Range(0.01f, 177.0f));
     cmd->add_option("--near", args.znear, "near clip distance (world units)");
     cmd->add_option("--far", args.zfar, "far clip distance (world units; 0 = infinite)");
@@ -132,14 +255,16 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
         ->check(CLI::Range(8, 256));
     cmd->add_option("--method", args.method, "depth-of-field method")
         ->capture_default_str()
-        ->check(CLI::IsMember({"pinhole"}));
-    cmd->add_option("--stats", args.stats_path, "write every parameter, stage times (ms) and "
-                                                "counts to this JSON file");
+        ->check(CLI::IsMember(methodNames()));
+    cmd->add_option("--stats", args.stats_path,
+                    "write every parameter, stage times (ms) and "
+                    "counts to this JSON file");
     cmd->add_option("--repeat", args.repeat, "render K times; stats keep every run and the median")
         ->capture_default_str()
         ->check(CLI::Range(1, 100000));
-    cmd->add_option("--depth-out", args.depth_out, "also write linear depth (distance along the "
-                                                   "view axis, world units) to this EXR");
+    cmd->add_option("--depth-out", args.depth_out,
+                    "also write linear depth (distance along the "
+                    "view axis, world units) to this EXR");
     cmd->add_option("--depth-format", args.depth_format, "depth buffer storage")
         ->capture_default_str()
         ->check(CLI::IsMember({"float32", "unorm16"}));
@@ -149,6 +274,69 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--texture-filter", args.texture_filter, "sampler: as the glTF sampler says")
         ->capture_default_str()
         ->check(CLI::IsMember({"sampler", "nearest", "bilinear", "trilinear"}));
+
+    // The lens (docs/dof/lens.md). Value checks (NaN, negative, focus beyond the far plane)
+    // happen in runRender so they print a sentence, not a validator message.
+    CLI::Option* aperture = cmd->add_option(
+        "--aperture-radius", args.aperture_radius,
+        "lens radius E in world units (0 = pinhole) [default: the scene's lens, else 0]");
+    CLI::Option* fstop = cmd->add_option(
+        "--fstop", args.fstop, "f-number N; with --focal-length: E = focal_length/(2 N) in metres");
+    CLI::Option* focal = cmd->add_option(
+        "--focal-length", args.focal_length_mm,
+        "lens focal length in mm; also sets yfov = 2 atan(sensor/2 / focal) (Blender)");
+    CLI::Option* sensor = cmd->add_option("--sensor-height", args.sensor_height_mm,
+                                          "sensor height in mm, vertical fit [default: 24]");
+    CLI::Option* focus_d = cmd->add_option(
+        "--focus-distance", args.focus_distance,
+        "focus distance d_f along the view axis (world units) [default: see docs/dof/lens.md]");
+    CLI::Option* focus_p =
+        cmd->add_option("--focus-pixel", args.focus_pixel,
+                        "focus on the depth a pinhole render shows at pixel X,Y");
+    fstop->needs(focal);
+    sensor->needs(focal);
+    aperture->excludes(fstop);
+    focus_d->excludes(focus_p);
+    cmd->get_option("--yfov")->excludes(focal);
+    cmd->add_option("--samples", args.samples, "accum: lens samples (views) N")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1 << 20));
+    cmd->add_flag("--pixel-jitter", args.pixel_jitter,
+                  "accum: also jitter the sub-pixel position per view (box-filter anti-aliasing)");
+    cmd->add_option("--lens-pattern", args.lens_pattern, "lens sample pattern")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"halton", "hammersley", "poisson"}));
+    cmd->add_option("--aperture-shape", args.aperture_shape,
+                    "circle, polygon (--aperture-blades) or image (--aperture-image) "
+                    "[default: circle]")
+        ->check(CLI::IsMember({"circle", "polygon", "image"}));
+    cmd->add_option("--aperture-blades", args.aperture_blades,
+                    "polygon aperture: number of blades (3-64) [default: 6]")
+        ->check(CLI::Range(3, 64));
+    cmd->add_option("--aperture-rotation", args.aperture_rotation_deg,
+                    "polygon aperture: rotation in degrees, counter-clockwise (0: a vertex up)")
+        ->capture_default_str();
+    cmd->add_option("--aperture-image", args.aperture_image,
+                    "aperture image (bokeh mask): transmission = mean RGB x alpha, top row = up");
+    cmd->add_option("--seed", args.seed,
+                    "lens pattern seed (0: the unrotated pattern; otherwise a Cranley-Patterson "
+                    "rotation and, for poisson, other candidates)")
+        ->capture_default_str();
+    cmd->add_flag("--no-progress", args.no_progress, "accum: no progress bar on stderr");
+    cmd->add_option("--precision", args.precision,
+                    "layered targets / fragment lists: 16 (half colour, unorm16 depth) or 32 "
+                    "(float) [default: the method's]")
+        ->check(CLI::IsMember({16, 32}));
+    cmd->add_option("--target-color", args.target_color,
+                    "layered targets / fragment lists: colour storage")
+        ->check(CLI::IsMember({"half", "float32"}));
+    cmd->add_option("--target-depth", args.target_depth,
+                    "layered targets / fragment lists: depth storage")
+        ->check(CLI::IsMember({"unorm16", "float32"}));
+    // Each method in apps/methods.cpp adds its own options.
+    for (MethodEntry& m : methodTable())
+        if (m.add_options)
+            m.add_options(*cmd);
     return cmd;
 }
 
@@ -157,6 +345,35 @@ int runRender(const RenderArgs& args) {
         return fail("--tile " + std::to_string(args.tile) + " must be a multiple of 8");
     if (!args.depth_out.empty() && !isLinearFormat(args.depth_out))
         return fail(args.depth_out + ": --depth-out must be an .exr file");
+    // Lens values the parser cannot judge (NaN, negative, zero).
+    for (const Status& s : {checkPositive("--aperture-radius", args.aperture_radius, true),
+                            checkPositive("--fstop", args.fstop, false),
+                            checkPositive("--focal-length", args.focal_length_mm, false),
+                            checkPositive("--sensor-height", args.sensor_height_mm, false),
+                            checkPositive("--focus-distance", args.focus_distance, false)})
+        if (!s.ok())
+            return fail(s.message());
+    if (!std::isfinite(args.aperture_rotation_deg))
+        return fail("--aperture-rotation must be a finite angle in degrees");
+    const bool is_accum = args.method == "accum";
+    const MethodEntry* table_method = findMethod(args.method);
+    const bool uses_lens = args.method != "pinhole";
+    const bool lens_options = args.aperture_radius || args.fstop || args.focus_distance ||
+                              args.focus_pixel || args.aperture_shape || args.aperture_blades ||
+                              !args.aperture_image.empty() || args.pixel_jitter;
+    if (!uses_lens && lens_options)
+        std::fprintf(stderr, "focal: warning: lens options have no effect with --method %s\n",
+                     args.method.c_str());
+    Result<glm::uvec2> focus_pixel = glm::uvec2(0);
+    if (args.focus_pixel) {
+        focus_pixel = parsePixel("--focus-pixel", *args.focus_pixel);
+        if (!focus_pixel.ok())
+            return fail(focus_pixel.status().message());
+    }
+    Result<dof::ApertureShape> aperture_shape = resolveAperture(args);
+    if (!aperture_shape.ok())
+        return fail(aperture_shape.status().message());
+
     Result<raster::Scene> scene = loadScene(args.scene);
     if (!scene.ok())
         return fail(scene.status().message());
@@ -165,17 +382,22 @@ int runRender(const RenderArgs& args) {
     Result<raster::View> view = resolveView(*scene, args);
     if (!view.ok())
         return fail(view.status().message());
+    // A focal length implies the field of view (Blender, vertical sensor fit).
+    const float sensor_mm = args.sensor_height_mm.value_or(24.0f);
+    if (args.focal_length_mm)
+        view->yfov = dof::yfovFromFocalLength(*args.focal_length_mm, sensor_mm);
+    if (Status s = raster::validate(*view); !s.ok())
+        return fail(s.message());
 
     raster::RenderOptions options;
     options.tile_size = args.tile;
-    options.depth_format =
-        args.depth_format == "unorm16" ? raster::DepthFormat::Unorm16 : raster::DepthFormat::Float32;
+    options.depth_format = args.depth_format == "unorm16" ? raster::DepthFormat::Unorm16
+                                                          : raster::DepthFormat::Float32;
     options.shading = args.shading == "unlit" ? raster::ShadingMode::Unlit
                       : args.shading == "lit" ? raster::ShadingMode::Lit
                                               : raster::ShadingMode::Material;
-    options.texture_filter = args.texture_filter == "nearest" ? raster::FilterOverride::Nearest
-                             : args.texture_filter == "bilinear"
-                                 ? raster::FilterOverride::Bilinear
+    options.texture_filter = args.texture_filter == "nearest"    ? raster::FilterOverride::Nearest
+                             : args.texture_filter == "bilinear" ? raster::FilterOverride::Bilinear
                              : args.texture_filter == "trilinear"
                                  ? raster::FilterOverride::Trilinear
                                  : raster::FilterOverride::Sampler;
@@ -184,33 +406,191 @@ int runRender(const RenderArgs& args) {
     raster::Renderer renderer(pool);
     raster::Frame frame;
     raster::FrameStats stats;
-    nlohmann::json runs = nlohmann::json::array();
-    std::vector<double> totals, geometry, binning, raster_ms;
-    for (uint32_t run = 0; run < args.repeat; ++run) {
-        const auto start = std::chrono::steady_clock::now();
-        if (Status s = renderer.render(*scene, *view, options, frame, &stats); !s.ok())
+    // Stage times summed over every renderer call of one run.
+    raster::FrameStats run_sum;
+    auto renderView = [&](const raster::View& v, raster::Frame& out) {
+        raster::FrameStats one;
+        Status s = renderer.render(*scene, v, options, out, &one);
+        run_sum.ms_geometry += one.ms_geometry;
+        run_sum.ms_binning += one.ms_binning;
+        run_sum.ms_raster += one.ms_raster;
+        stats = one;
+        return s;
+    };
+
+    // Resolve the lens: aperture, then focus distance (docs/dof/lens.md, "Defaults").
+    LensChoice choice;
+    float aperture_radius = 0.0f;
+    if (args.aperture_radius) {
+        aperture_radius = *args.aperture_radius;
+        choice.aperture_source = "cli";
+    } else if (args.fstop) {
+        aperture_radius = dof::apertureRadiusFromFStop(*args.focal_length_mm, *args.fstop);
+        choice.aperture_source = "fstop";
+    } else if (scene->lens) {
+        aperture_radius = scene->lens->aperture_radius;
+        choice.aperture_source = "scene";
+    }
+    float focus_distance = view->focus_distance;
+    const bool look_at = args.eye.has_value();
+    if (args.focus_distance) {
+        focus_distance = *args.focus_distance;
+        choice.focus_source = "cli";
+    } else if (args.focus_pixel || (uses_lens && !look_at && !scene->lens)) {
+        // Render the pinhole (independent of the lens) and read its depth.
+        const auto t0 = std::chrono::steady_clock::now();
+        raster::View pin = *view;
+        pin.lens_offset = glm::vec2(0.0f);
+        pin.pixel_shift = glm::vec2(0.0f);
+        if (Status s = renderView(pin, frame); !s.ok())
             return fail(s.message());
+        choice.ms_focus =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
+        if (args.focus_pixel) {
+            Result<float> d =
+                dof::focusDistanceAtPixel(frame, *view, focus_pixel->x, focus_pixel->y);
+            if (!d.ok())
+                return fail(d.status().message());
+            focus_distance = *d;
+            choice.focus_source = "focus-pixel";
+        } else if (Result<float> d =
+                       dof::focusDistanceAtPixel(frame, *view, view->width / 2, view->height / 2);
+                   d.ok()) {
+            focus_distance = *d;
+            choice.focus_source = "autofocus";
+        } else {
+            const raster::Bounds b = raster::worldBounds(*scene);
+            const float along = glm::dot(0.5f * (b.min + b.max) - view->eye, view->forward);
+            if (!b.empty && along > 0.0f) {
+                focus_distance = along;
+                choice.focus_source = "bounds";
+            }
+        }
+    } else if (look_at) {
+        choice.focus_source = "target";
+    } else if (scene->lens) {
+        focus_distance = scene->lens->focus_distance;
+        choice.focus_source = "scene";
+    }
+    choice.lens = dof::makeThinLens(*view, aperture_radius, focus_distance);
+    if (uses_lens || lens_options)
+        if (Status s = dof::validate(choice.lens, *view); !s.ok())
+            return fail(s.message());
+    view->focus_distance = focus_distance;
+
+    Result<dof::LensSampleSet> lens_samples = dof::LensSampleSet::create(
+        *aperture_shape, patternOf(args.lens_pattern), uses_lens ? args.samples : 1, args.seed);
+    if (!lens_samples.ok())
+        return fail(lens_samples.status().message());
+
+    // Target storage for the table's methods.
+    std::optional<raster::ColorFormat> target_color;
+    std::optional<raster::DepthFormat> target_depth;
+    if (args.precision) {
+        target_color =
+            *args.precision == 16 ? raster::ColorFormat::Half : raster::ColorFormat::Float32;
+        target_depth =
+            *args.precision == 16 ? raster::DepthFormat::Unorm16 : raster::DepthFormat::Float32;
+    }
+    if (args.target_color)
+        target_color =
+            *args.target_color == "half" ? raster::ColorFormat::Half : raster::ColorFormat::Float32;
+    if (args.target_depth)
+        target_depth = *args.target_depth == "unorm16" ? raster::DepthFormat::Unorm16
+                                                       : raster::DepthFormat::Float32;
+    MethodOutput method_out;
+    std::vector<std::pair<std::string, std::vector<double>>> method_stage_ms;
+
+    nlohmann::json runs = nlohmann::json::array();
+    std::vector<double> totals, geometry, binning, raster_ms, pinhole_ms, views_ms, accum_ms;
+    dof::AccumStats accum_stats;
+    const bool show_progress =
+        is_accum && !args.no_progress && args.samples > 1 && ::isatty(::fileno(stderr)) == 1;
+    for (uint32_t run = 0; run < args.repeat; ++run) {
+        run_sum = raster::FrameStats{};
+        const auto start = std::chrono::steady_clock::now();
+        if (is_accum) {
+            ProgressBar bar(show_progress);
+            dof::AccumSettings settings;
+            settings.pixel_jitter = args.pixel_jitter;
+            Result<dof::AccumStats> r = dof::renderAccum(
+                *view, choice.lens, *lens_samples, settings, renderView, frame, &pool,
+                [&bar](uint32_t done, uint32_t total) { bar.update(done, total); });
+            if (!r.ok())
+                return fail(r.status().message());
+            accum_stats = *r;
+        } else if (table_method) {
+            MethodInput in{*scene, *view,   choice.lens,  *lens_samples,
+                           pool,   options, target_color, target_depth};
+            method_out = MethodOutput{};
+            if (Status s = table_method->run(in, method_out); !s.ok())
+                return fail(s.message());
+            if (method_out.rgba.size() != size_t(view->width) * view->height * 4)
+                return fail("--method " + args.method + " returned an image of the wrong size");
+            frame.width = view->width;
+            frame.height = view->height;
+            frame.color = method_out.rgba;
+        } else if (Status s = renderView(*view, frame); !s.ok()) {
+            return fail(s.message());
+        }
         const double total =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
         totals.push_back(total);
-        geometry.push_back(stats.ms_geometry);
-        binning.push_back(stats.ms_binning);
-        raster_ms.push_back(stats.ms_raster);
-        runs.push_back({{"total", total},
-                        {"geometry", stats.ms_geometry},
-                        {"binning", stats.ms_binning},
-                        {"raster", stats.ms_raster}});
+        geometry.push_back(run_sum.ms_geometry);
+        binning.push_back(run_sum.ms_binning);
+        raster_ms.push_back(run_sum.ms_raster);
+        nlohmann::json one = {{"total", total},
+                              {"geometry", run_sum.ms_geometry},
+                              {"binning", run_sum.ms_binning},
+                              {"raster", run_sum.ms_raster}};
+        if (is_accum) {
+            pinhole_ms.push_back(accum_stats.ms_pinhole);
+            views_ms.push_back(accum_stats.ms_views);
+            accum_ms.push_back(accum_stats.ms_accumulate);
+            one["pinhole"] = accum_stats.ms_pinhole;
+            one["views"] = accum_stats.ms_views;
+            one["accumulate"] = accum_stats.ms_accumulate;
+        }
+        for (size_t k = 0; k < method_out.stage_ms.size(); ++k) {
+            const auto& [stage, ms] = method_out.stage_ms[k];
+            one[stage] = ms;
+            if (method_stage_ms.size() <= k)
+                method_stage_ms.push_back({stage, {}});
+            method_stage_ms[k].second.push_back(ms);
+        }
+        runs.push_back(one);
     }
+    if (is_accum && accum_stats.skipped)
+        std::fprintf(stderr, "focal: note: accum rendered once: %s\n",
+                     accum_stats.skip_reason.c_str());
 
     ImageData color{frame.width, frame.height, 4, frame.color};
     if (Status s = writeImage(args.output, color); !s.ok())
         return fail(s.message());
     if (!args.depth_out.empty()) {
+        // The pinhole depth: pinhole and accum leave it in the frame; a table method returns
+        // its own, or gets a pinhole render here.
         ImageData depth{frame.width, frame.height, 1, {}};
-        depth.pixels.resize(size_t(frame.width) * frame.height);
-        for (size_t i = 0; i < depth.pixels.size(); ++i)
-            depth.pixels[i] = raster::distanceFromDepth(*view, frame.depth.load(uint32_t(i)));
+        if (table_method && !method_out.depth.empty()) {
+            depth.pixels = method_out.depth;
+        } else {
+            if (table_method) {
+                raster::View pin = *view;
+                pin.lens_offset = glm::vec2(0.0f);
+                pin.pixel_shift = glm::vec2(0.0f);
+                raster::Frame depth_frame;
+                if (Status s = renderer.render(*scene, pin, options, depth_frame); !s.ok())
+                    return fail(s.message());
+                frame.depth = std::move(depth_frame.depth);
+            }
+            depth.pixels.resize(size_t(frame.width) * frame.height);
+            for (size_t i = 0; i < depth.pixels.size(); ++i)
+                depth.pixels[i] = raster::distanceFromDepth(*view, frame.depth.load(uint32_t(i)));
+        }
+        if (depth.pixels.size() != size_t(frame.width) * frame.height)
+            return fail("--method " + args.method + " returned a depth image of the wrong size");
         if (Status s = writeImage(args.depth_out, depth); !s.ok())
             return fail(s.message());
     }
@@ -235,26 +615,85 @@ int runRender(const RenderArgs& args) {
                        {"near", v.znear},
                        {"far", v.zfar},
                        {"focus_distance", v.focus_distance}};
+        const dof::ThinLens& lens = choice.lens;
+        nlohmann::json lj = {{"aperture_radius", lens.aperture_radius},
+                             {"aperture_source", choice.aperture_source},
+                             {"focus_distance", lens.focus_distance},
+                             {"focus_source", choice.focus_source},
+                             {"focal_length_px", lens.focal_length_px},
+                             {"coc_at_infinity_px", dof::cocRadiusPx(lens, INFINITY)},
+                             {"aperture_shape", apertureKindName(aperture_shape->kind)},
+                             {"lens_pattern", args.lens_pattern},
+                             {"seed", args.seed}};
+        if (args.fstop)
+            lj["fstop"] = *args.fstop;
+        if (args.focal_length_mm) {
+            lj["focal_length_mm"] = *args.focal_length_mm;
+            lj["sensor_height_mm"] = sensor_mm;
+        }
+        if (args.focus_pixel)
+            lj["focus_pixel"] = {focus_pixel->x, focus_pixel->y};
+        if (aperture_shape->kind == dof::ApertureKind::Polygon) {
+            lj["aperture_blades"] = aperture_shape->blades;
+            lj["aperture_rotation_deg"] = aperture_shape->rotation_deg;
+        }
+        if (aperture_shape->kind == dof::ApertureKind::Image)
+            lj["aperture_image"] = args.aperture_image;
+        j["lens"] = lj;
         j["time_ms"] = {{"total", median(totals)},
                         {"geometry", median(geometry)},
                         {"binning", median(binning)},
                         {"raster", median(raster_ms)}};
+        if (choice.ms_focus > 0.0)
+            j["time_ms"]["focus"] = choice.ms_focus;
+        if (is_accum) {
+            j["time_ms"]["pinhole"] = median(pinhole_ms);
+            j["time_ms"]["views"] = median(views_ms);
+            j["time_ms"]["accumulate"] = median(accum_ms);
+            nlohmann::json aj = {{"samples", args.samples},
+                                 {"pixel_jitter", args.pixel_jitter},
+                                 {"views", accum_stats.views},
+                                 {"renders", accum_stats.renders},
+                                 {"skipped", accum_stats.skipped}};
+            if (accum_stats.skipped)
+                aj["skip_reason"] = accum_stats.skip_reason;
+            if (accum_stats.coc.covered)
+                aj["visible_coc_px"] = {{"min", accum_stats.coc.min_px},
+                                        {"max", accum_stats.coc.max_px},
+                                        {"max_abs", accum_stats.coc.max_abs_px}};
+            j["accum"] = aj;
+        }
+        for (const auto& [stage, ms] : method_stage_ms)
+            j["time_ms"][stage] = median(ms);
+        if (table_method) {
+            j["params"] = method_out.params;
+            j["counts"] = method_out.counts;
+            j["lens"]["samples"] = args.samples;
+            if (target_color)
+                j["target_color"] = *target_color == raster::ColorFormat::Half ? "half" : "float32";
+            if (target_depth)
+                j["target_depth"] =
+                    *target_depth == raster::DepthFormat::Unorm16 ? "unorm16" : "float32";
+        }
         j["runs"] = runs;
         j["triangles"] = {{"in", stats.triangles_in},
                           {"culled", stats.triangles_culled},
                           {"clipped", stats.triangles_clipped},
                           {"setup", stats.triangles_setup}};
-        j["fragments"] = {{"covered", stats.fragments_covered},
-                          {"passed", stats.fragments_passed}};
+        j["fragments"] = {{"covered", stats.fragments_covered}, {"passed", stats.fragments_passed}};
         if (Status s = writeTextFile(args.stats_path, j.dump(2) + "\n"); !s.ok())
             return fail(s.message());
     }
     std::printf("focal: wrote %s", args.output.c_str());
     if (!args.depth_out.empty())
         std::printf(" and %s", args.depth_out.c_str());
-    std::printf(" (%ux%u, %s, %.1f ms)\n", frame.width, frame.height, args.method.c_str(),
-                median(totals));
+    if (is_accum)
+        std::printf(" (%ux%u, accum %u views, %.1f ms)\n", frame.width, frame.height,
+                    accum_stats.views, median(totals));
+    else
+        std::printf(" (%ux%u, %s, %.1f ms)\n", frame.width, frame.height, args.method.c_str(),
+                    median(totals));
     return 0;
 }
 
-}  // namespace focal
+} // namespace focal

@@ -3,12 +3,12 @@
 
 #include <raster/renderer.h>
 
+#include <CLI/CLI.hpp>
+#include <glm/vec3.hpp>
+
 #include <cstdint>
 #include <optional>
 #include <string>
-
-#include <CLI/CLI.hpp>
-#include <glm/vec3.hpp>
 
 namespace focal {
 
@@ -20,7 +20,7 @@ struct RenderArgs {
     std::optional<int> camera;
     std::optional<std::string> eye, target, up;
     std::optional<float> yfov_deg, znear, zfar;
-    uint32_t threads = 0;  // set to the hardware thread count by addRenderCommand
+    uint32_t threads = 0; // set to the hardware thread count by addRenderCommand
     uint32_t tile = 64;
     std::string method = "pinhole";
     std::string stats_path;
@@ -29,6 +29,30 @@ struct RenderArgs {
     std::string depth_format = "float32";
     std::string shading = "material";
     std::string texture_filter = "sampler";
+
+    // Lens (dof/lens.h). Unset values come from the scene's LensHint, then the defaults
+    // documented in docs/dof/lens.md.
+    std::optional<float> aperture_radius;   // E, world units
+    std::optional<float> fstop;             // with focal_length_mm: E = f / (2 N)
+    std::optional<float> focal_length_mm;   // also sets yfov from the sensor height
+    std::optional<float> sensor_height_mm;  // default 24 (vertical fit)
+    std::optional<float> focus_distance;    // d_f, world units
+    std::optional<std::string> focus_pixel; // "X,Y": focus on the depth seen there
+    // Lens sampling (dof/lens_samples.h) and accum (dof/accum.h).
+    uint32_t samples = 64;
+    bool pixel_jitter = false;
+    std::string lens_pattern = "hammersley";
+    std::optional<std::string> aperture_shape; // circle | polygon | image
+    std::optional<uint32_t> aperture_blades;
+    float aperture_rotation_deg = 0.0f;
+    std::string aperture_image;
+    uint32_t seed = 0;
+    bool no_progress = false;
+    // Storage of layered targets / fragment lists for the methods in apps/methods.cpp:
+    // --precision 16|32 sets both; --target-color half|float32, --target-depth unorm16|float32
+    // override one. Unset: the method's default.
+    std::optional<int> precision;
+    std::optional<std::string> target_color, target_depth;
 };
 
 // Registers the subcommand; `args` must outlive parsing.
@@ -37,4 +61,4 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args);
 // Runs it; returns the exit code (errors are printed).
 int runRender(const RenderArgs& args);
 
-}  // namespace focal
+} // namespace focal

@@ -1,0 +1,127 @@
+#include <dof/accum.h>
+
+#include <chrono>
+#include <cstdio>
+#include <vector>
+
+namespace dof {
+
+using raster::Status;
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace
+
+raster::View lensView(const raster::View& view, const ThinLens& lens, glm::vec2 sample,
+                      glm::vec2 pixel_shift) {
+    // Haeberli & Akeley 1990: move the eye to the lens point eye + E (v.x right + v.y up) and
+    // shear the frustum so the plane d = d_f keeps its pixels (raster::projectionMatrix).
+    raster::View v = view;
+    v.lens_offset = lens.aperture_radius * sample;
+    v.focus_distance = lens.focus_distance;
+    v.pixel_shift = pixel_shift;
+    return v;
+}
+
+glm::vec2 pixelJitter(uint32_t index) {
+    auto centred = [](float r) {
+        const float s = r + 0.5f;
+        return (s >= 1.0f ? s - 1.0f : s) - 0.5f;
+    };
+    return {centred(radicalInverse(5, index)), centred(radicalInverse(7, index))};
+}
+
+raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens& lens,
+                                       const LensSampleSet& samples, const AccumSettings& settings,
+                                       const RenderFn& render, raster::Frame& out,
+                                       raster::TaskPool* pool, const ProgressFn& progress) {
+    if (Status s = validate(lens, view); !s.ok())
+        return s;
+    if (samples.size() == 0)
+        return Status::error("--samples must be at least 1");
+    AccumStats stats;
+    using Clock = std::chrono::steady_clock;
+
+    // Pinhole view (lens centre): the output depth, the visible CoC range, and the result
+    // whenever the lens cannot change the image.
+    auto t0 = Clock::now();
+    const raster::View pinhole = lensView(view, lens, {0.0f, 0.0f}, {0.0f, 0.0f});
+    if (Status s = render(pinhole, out); !s.ok())
+        return s;
+    stats.renders = 1;
+    stats.ms_pinhole = msSince(t0);
+    stats.coc = visibleCocRange(lens, out, view);
+    if (!settings.pixel_jitter) {
+        char buf[160];
+        if (lens.aperture_radius == 0.0f) {
+            stats.skipped = true;
+            stats.skip_reason = "aperture radius is 0 (pinhole)";
+        } else if (stats.coc.max_abs_px < 0.5f) {
+            stats.skipped = true;
+            std::snprintf(buf, sizeof buf, "every visible depth has |C(d)| < 0.5 px (max %.3f px)",
+                          double(stats.coc.max_abs_px));
+            stats.skip_reason = buf;
+        }
+        if (stats.skipped) {
+            if (progress)
+                progress(1, 1);
+            return stats;
+        }
+    }
+
+    // One view per lens sample, added in sample order (the determinism contract).
+    const uint32_t width = out.width, height = out.height;
+    const size_t floats = size_t(width) * height * 4;
+    std::vector<double> acc(floats, 0.0);
+    raster::Frame scratch;
+    double weight_sum = 0.0;
+    const uint32_t n = samples.size();
+    for (uint32_t i = 0; i < n; ++i) {
+        const LensSample& ls = samples.sample(i);
+        const glm::vec2 shift = settings.pixel_jitter ? pixelJitter(i) : glm::vec2(0.0f);
+        const raster::View v = lensView(view, lens, ls.position, shift);
+        const raster::Frame* src = &out; // the lens centre without shift is the pinhole
+        if (v.lens_offset != glm::vec2(0.0f) || shift != glm::vec2(0.0f)) {
+            t0 = Clock::now();
+            if (Status s = render(v, scratch); !s.ok())
+                return s;
+            ++stats.renders;
+            stats.ms_views += msSince(t0);
+            if (scratch.width != width || scratch.height != height)
+                return Status::error("accum: the render callback changed the image size");
+            src = &scratch;
+        }
+        t0 = Clock::now();
+        const double w = double(ls.weight);
+        const float* color = src->color.data();
+        auto addRow = [&](uint32_t row, uint32_t) {
+            const size_t begin = size_t(row) * width * 4, end = begin + size_t(width) * 4;
+            for (size_t k = begin; k < end; ++k)
+                acc[k] += w * double(color[k]);
+        };
+        if (pool)
+            pool->parallelFor(height, addRow);
+        else
+            for (uint32_t row = 0; row < height; ++row)
+                addRow(row, 0);
+        weight_sum += w;
+        stats.ms_accumulate += msSince(t0);
+        ++stats.views;
+        if (progress)
+            progress(i + 1, n);
+    }
+
+    // Normalise by the weight sum (1 up to rounding) and store as float.
+    t0 = Clock::now();
+    const double inv = 1.0 / weight_sum;
+    for (size_t k = 0; k < floats; ++k)
+        out.color[k] = float(acc[k] * inv);
+    stats.ms_accumulate += msSince(t0);
+    return stats;
+}
+
+} // namespace dof

@@ -1,0 +1,87 @@
+#include <dof/lens.h>
+
+#include <cmath>
+#include <string>
+
+namespace dof {
+
+using raster::Status;
+
+ThinLens makeThinLens(const raster::View& view, float aperture_radius, float focus_distance) {
+    ThinLens lens;
+    lens.aperture_radius = aperture_radius;
+    lens.focus_distance = focus_distance;
+    lens.focal_length_px = raster::focalLengthPx(view);
+    return lens;
+}
+
+float cocRadiusPx(const ThinLens& lens, float depth) {
+    // Lee et al. 2009 Eq. 3 in pixels: C(d) = E f_px (1/d_f - 1/d); 1/inf = 0 gives C(inf).
+    const float inv_d = std::isinf(depth) ? 0.0f : 1.0f / depth;
+    return lens.aperture_radius * lens.focal_length_px * (1.0f / lens.focus_distance - inv_d);
+}
+
+glm::vec2 lensRayImageOffset(float coc_radius_px, glm::vec2 v) {
+    // Camera y is up, pixel rows grow downwards: only x changes sign (DESIGN.md, "The lens").
+    return {-coc_radius_px * v.x, coc_radius_px * v.y};
+}
+
+float apertureRadiusFromFStop(float focal_length_mm, float fstop) {
+    return focal_length_mm * 1e-3f / (2.0f * fstop);
+}
+
+float yfovFromFocalLength(float focal_length_mm, float sensor_height_mm) {
+    return 2.0f * std::atan(0.5f * sensor_height_mm / focal_length_mm);
+}
+
+Status validate(const ThinLens& lens, const raster::View& view) {
+    if (!std::isfinite(lens.aperture_radius) || lens.aperture_radius < 0.0f)
+        return Status::error("--aperture-radius must be a finite number >= 0 (world units), got " +
+                             std::to_string(lens.aperture_radius));
+    if (!std::isfinite(lens.focus_distance) || lens.focus_distance <= 0.0f)
+        return Status::error("--focus-distance must be a finite number > 0 (world units), got " +
+                             std::to_string(lens.focus_distance));
+    if (view.zfar > 0.0f && lens.focus_distance > view.zfar)
+        return Status::error("focus distance " + std::to_string(lens.focus_distance) +
+                             " lies behind the far plane (" + std::to_string(view.zfar) +
+                             "); nothing visible could be in focus");
+    if (!std::isfinite(lens.focal_length_px) || lens.focal_length_px <= 0.0f)
+        return Status::error("focal length in pixels must be finite and > 0");
+    return {};
+}
+
+raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const raster::View& view,
+                                           uint32_t x, uint32_t y) {
+    if (x >= pinhole.width || y >= pinhole.height)
+        return Status::error("--focus-pixel " + std::to_string(x) + "," + std::to_string(y) +
+                             " lies outside the " + std::to_string(pinhole.width) + "x" +
+                             std::to_string(pinhole.height) + " image");
+    const float stored = pinhole.depth.load(y * pinhole.width + x);
+    const float d = raster::distanceFromDepth(view, stored);
+    if (stored >= 1.0f || !std::isfinite(d) || d <= 0.0f)
+        return Status::error("--focus-pixel " + std::to_string(x) + "," + std::to_string(y) +
+                             " shows only background; there is no depth to focus on");
+    return d;
+}
+
+CocRange visibleCocRange(const ThinLens& lens, const raster::Frame& pinhole,
+                         const raster::View& view) {
+    CocRange r;
+    const uint32_t count = pinhole.width * pinhole.height;
+    for (uint32_t i = 0; i < count; ++i) {
+        const float stored = pinhole.depth.load(i);
+        if (stored >= 1.0f)
+            continue;
+        const float c = cocRadiusPx(lens, raster::distanceFromDepth(view, stored));
+        if (!r.covered) {
+            r.min_px = r.max_px = c;
+            r.covered = true;
+        }
+        r.min_px = std::fmin(r.min_px, c);
+        r.max_px = std::fmax(r.max_px, c);
+    }
+    r.max_abs_px = std::fmax(std::fabs(r.min_px), std::fabs(r.max_px));
+    return r;
+}
+
+} // namespace dof

@@ -1,0 +1,78 @@
+// dof/lens.h: the thin-lens CoC, its signs, the photographic mapping and validation.
+#include "dof_test_util.h"
+
+#include <dof/lens.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace focal::test {
+namespace {
+
+TEST(Lens, CocIsSignedAndZeroAtTheFocusDistance) {
+    const raster::View view = pixelView(64, 64, 100.0f);
+    const dof::ThinLens lens = dof::makeThinLens(view, 2.0f, 100.0f);
+    EXPECT_FLOAT_EQ(lens.focal_length_px, 100.0f);
+    EXPECT_EQ(dof::cocRadiusPx(lens, 100.0f), 0.0f);
+    EXPECT_LT(dof::cocRadiusPx(lens, 50.0f), 0.0f);  // in front: negative
+    EXPECT_GT(dof::cocRadiusPx(lens, 200.0f), 0.0f); // behind: positive
+    // E f (1/d_f - 1/d): 2 * 100 * (0.01 - 0.02) = -2; 2 * 100 * (0.01 - 0.005) = 1.
+    EXPECT_FLOAT_EQ(dof::cocRadiusPx(lens, 50.0f), -2.0f);
+    EXPECT_FLOAT_EQ(dof::cocRadiusPx(lens, 200.0f), 1.0f);
+    EXPECT_FLOAT_EQ(dof::cocRadiusPx(lens, INFINITY), 2.0f);
+    // Affine in 1/d (Lee et al. 2009, Sec. 4.1: layers uniform in C).
+    const float c1 = dof::cocRadiusPx(lens, 1.0f / 0.004f),
+                c2 = dof::cocRadiusPx(lens, 1.0f / 0.006f),
+                c3 = dof::cocRadiusPx(lens, 1.0f / 0.008f);
+    EXPECT_NEAR(c2 - c1, c3 - c2, 1e-5f);
+}
+
+TEST(Lens, LensRayOffsetFlipsY) {
+    const glm::vec2 o = dof::lensRayImageOffset(4.0f, {0.5f, 0.25f});
+    EXPECT_FLOAT_EQ(o.x, -2.0f);
+    EXPECT_FLOAT_EQ(o.y, 1.0f);
+}
+
+TEST(Lens, BlenderFStopMapping) {
+    // 50 mm at f/2: E = 0.05 / 4 = 12.5 mm; 24 mm sensor: yfov = 2 atan(12/50) = 26.99 degrees.
+    EXPECT_FLOAT_EQ(dof::apertureRadiusFromFStop(50.0f, 2.0f), 0.0125f);
+    EXPECT_NEAR(dof::yfovFromFocalLength(50.0f, 24.0f) * 180.0f / 3.14159265f, 26.9915f, 1e-3f);
+}
+
+TEST(Lens, ValidateRejectsNonsense) {
+    raster::View view = pixelView(64, 64, 100.0f); // far = 400
+    EXPECT_TRUE(dof::validate(dof::makeThinLens(view, 0.0f, 100.0f), view).ok());
+    EXPECT_FALSE(dof::validate(dof::makeThinLens(view, -0.1f, 100.0f), view).ok());
+    EXPECT_FALSE(dof::validate(dof::makeThinLens(view, NAN, 100.0f), view).ok());
+    EXPECT_FALSE(dof::validate(dof::makeThinLens(view, INFINITY, 100.0f), view).ok());
+    EXPECT_FALSE(dof::validate(dof::makeThinLens(view, 1.0f, 0.0f), view).ok());
+    EXPECT_FALSE(dof::validate(dof::makeThinLens(view, 1.0f, -5.0f), view).ok());
+    EXPECT_FALSE(dof::validate(dof::makeThinLens(view, 1.0f, NAN), view).ok());
+    const raster::Status behind = dof::validate(dof::makeThinLens(view, 1.0f, 401.0f), view);
+    EXPECT_FALSE(behind.ok());
+    EXPECT_NE(behind.message().find("far plane"), std::string::npos);
+    view.zfar = 0.0f; // infinite far plane: any positive focus distance
+    EXPECT_TRUE(dof::validate(dof::makeThinLens(view, 1.0f, 1e6f), view).ok());
+}
+
+TEST(Lens, FocusDistanceAtPixel) {
+    const raster::View view = pixelView(64, 64, 100.0f);
+    raster::Scene scene;
+    const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
+    addQuad(scene, -10.0f, -10.0f, 10.0f, 10.0f, 150.0f, white); // pixels ~[25,39)
+    const raster::Frame f = render(scene, view);
+    raster::Result<float> d = dof::focusDistanceAtPixel(f, view, 32, 32);
+    ASSERT_TRUE(d.ok());
+    EXPECT_NEAR(*d, 150.0f, 1e-2f);
+    EXPECT_FALSE(dof::focusDistanceAtPixel(f, view, 2, 2).ok());   // background
+    EXPECT_FALSE(dof::focusDistanceAtPixel(f, view, 64, 10).ok()); // outside
+    const dof::CocRange range =
+        dof::visibleCocRange(dof::makeThinLens(view, 3.0f, 100.0f), f, view);
+    EXPECT_TRUE(range.covered);
+    EXPECT_NEAR(range.max_px, 1.0f, 1e-3f); // 3 * 100 * (1/100 - 1/150)
+    EXPECT_NEAR(range.min_px, 1.0f, 1e-3f);
+}
+
+} // namespace
+} // namespace focal::test
