@@ -1,0 +1,192 @@
+#include "apps/method_multilayer.h"
+
+#include "apps/image_io.h"
+
+#include <dof/multilayer.h>
+#include <raster/camera.h>
+#include <raster/fragment_lists.h>
+#include <raster/renderer.h>
+
+#include <charconv>
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace focal {
+
+namespace {
+
+// Values of the multilayer options (owned by the entry, shared by its two functions).
+struct MultilayerArgs {
+    dof::MultilayerSettings settings;
+    std::string stack_levels = "auto";
+    std::string truncate = "on";
+    std::string blend = "additive";
+    std::string levels_out; // prefix of the per-level contribution images (Fig. 7)
+};
+
+const char* kindName(dof::LevelKind k) {
+    return k == dof::LevelKind::Base ? "base" : (k == dof::LevelKind::Mip ? "mip" : "stack");
+}
+
+// Per-axis second moment of the aperture from the lens samples when there are enough of them to
+// describe its shape; the uniform disk's 1/4 otherwise.
+double apertureSecondMoment(const dof::LensSampleSet& samples) {
+    if (samples.size() < 64)
+        return 0.25;
+    double m = 0.0, w = 0.0;
+    for (const dof::LensSample& s : samples.samples()) {
+        m += double(s.weight) * 0.5 *
+             (double(s.position.x) * double(s.position.x) +
+              double(s.position.y) * double(s.position.y));
+        w += double(s.weight);
+    }
+    return w > 0.0 && m > 0.0 ? m / w : 0.25;
+}
+
+raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, MethodOutput& out) {
+    dof::MultilayerSettings settings = args.settings;
+    if (args.stack_levels == "auto") {
+        settings.stack_levels = -1;
+    } else {
+        uint32_t v = 0;
+        const char* first = args.stack_levels.data();
+        const char* last = first + args.stack_levels.size();
+        const std::from_chars_result r = std::from_chars(first, last, v);
+        if (r.ec != std::errc() || r.ptr != last || v > dof::kMaxFilterLevels)
+            return raster::Status::error("--stack-levels must be a count in [0, " +
+                                         std::to_string(dof::kMaxFilterLevels) +
+                                         "] or 'auto', got '" + args.stack_levels + "'");
+        settings.stack_levels = int32_t(v);
+    }
+    settings.truncate = args.truncate == "on";
+    settings.blend = args.blend == "additive" ? dof::LayerBlend::Additive : dof::LayerBlend::Over;
+    settings.color_format = in.target_color.value_or(raster::ColorFormat::Half);
+    settings.depth_format = in.target_depth.value_or(raster::DepthFormat::Float32);
+    settings.aperture_second_moment = apertureSecondMoment(in.lens_samples);
+    settings.level_contributions = !args.levels_out.empty();
+
+    raster::View pinhole = in.view;
+    pinhole.lens_offset = glm::vec2(0.0f);
+    pinhole.pixel_shift = glm::vec2(0.0f);
+    raster::Renderer renderer(in.pool);
+    raster::FrameStats raster_stats;
+    const dof::CollectFn collect = [&](const raster::FragmentListDesc& desc,
+                                       raster::FragmentLists& lists) {
+        return renderer.renderFragmentLists(in.scene, pinhole, in.options, desc, lists,
+                                            &raster_stats);
+    };
+    dof::Multilayer multilayer;
+    dof::MultilayerImage image;
+    dof::MultilayerStats st;
+    if (raster::Status s = multilayer.render(pinhole, in.lens, in.scene.background, settings,
+                                             collect, in.pool, image, &st);
+        !s.ok())
+        return s;
+
+    if (!args.levels_out.empty()) {
+        // One image per level (premultiplied contribution) and the background's share.
+        for (size_t s = 0; s < image.level_rgba.size(); ++s) {
+            ImageData img{image.width, image.height, 4, image.level_rgba[s]};
+            for (size_t i = 0; i < img.pixels.size() / 4; ++i)
+                img.pixels[4 * i + 3] = 1.0f;
+            const std::string name =
+                s + 1 == image.level_rgba.size() ? "background" : "level" + std::to_string(s);
+            const std::string path = args.levels_out + name + ".png";
+            if (raster::Status w = writeImage(path, img); !w.ok())
+                return w;
+        }
+    }
+
+    out.rgba = std::move(image.rgba);
+    out.depth = std::move(image.depth);
+    out.stage_ms = {
+        {"collect", st.ms_collect}, {"filter", st.ms_filter}, {"accumulate", st.ms_accumulate}};
+    out.params = {
+        {"fragments_per_pixel", settings.fragments_per_pixel},
+        {"mip_levels", st.mip_levels},
+        {"stack_levels", st.stack_levels},
+        {"stack_levels_option", args.stack_levels},
+        {"epsilon", settings.epsilon},
+        {"truncate", settings.truncate},
+        {"blend", args.blend},
+        {"aperture_second_moment", settings.aperture_second_moment},
+        {"color_format", settings.color_format == raster::ColorFormat::Half ? "half" : "float32"},
+        {"depth_format",
+         settings.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"}};
+    nlohmann::json levels = nlohmann::json::array();
+    for (const dof::MultilayerLevelStats& l : st.levels) {
+        auto finite = [](float z) {
+            return std::isfinite(z) ? nlohmann::json(z) : nlohmann::json(nullptr);
+        };
+        levels.push_back({{"level", l.index},
+                          {"kind", kindName(l.kind)},
+                          {"width", l.width},
+                          {"height", l.height},
+                          {"dilation", l.dilation},
+                          {"fragments", l.fragments},
+                          {"max_list_length", l.max_list_length},
+                          {"mean_list_length", l.mean_list_length},
+                          {"truncated", l.truncated},
+                          {"radius_px", l.radius_px},
+                          {"z_near", finite(l.z_near)},
+                          {"z_far", finite(l.z_far)}});
+    }
+    out.counts = {{"fragments_collected", st.fragments_collected},
+                  {"fragments_kept", st.fragments_kept},
+                  {"max_list_length", st.max_list_length},
+                  {"node_pool_grew", st.node_pool_grew},
+                  {"max_coc_px", st.max_coc_px},
+                  {"slices_blended", st.slices_blended},
+                  {"ms_raster", raster_stats.ms_raster},
+                  {"ms_resolve", raster_stats.ms_resolve},
+                  {"levels", levels}};
+    return {};
+}
+
+} // namespace
+
+MethodEntry makeMultilayerMethod() {
+    auto args = std::make_shared<MultilayerArgs>();
+    MethodEntry e;
+    e.name = "multilayer";
+    e.summary = "Selgrad et al. 2015: filtered per-pixel fragment lists (docs/dof/multilayer.md)";
+    e.add_options = [args](CLI::App& render) {
+        render
+            .add_option("--fragments-per-pixel", args->settings.fragments_per_pixel,
+                        "multilayer: closest N fragments kept per pixel (§4; 0 = all)")
+            ->default_val(4);
+        render
+            .add_option("--mip-levels", args->settings.mip_levels,
+                        "multilayer: mip-mapping steps before the filter stack (§5.2 Y-map)")
+            ->default_val(2);
+        render
+            .add_option("--stack-levels", args->stack_levels,
+                        "multilayer: stack filtering steps, or 'auto' (enough levels for the "
+                        "largest circle of confusion)")
+            ->default_val("auto");
+        render
+            .add_option("--epsilon", args->settings.epsilon,
+                        "multilayer: depth threshold for merging fragments, relative to depth "
+                        "(§5.1)")
+            ->default_val(0.2f);
+        render
+            .add_option("--truncate", args->truncate, "multilayer: fragment list truncation (§6.2)")
+            ->check(CLI::IsMember({"on", "off"}))
+            ->default_val("on");
+        render
+            .add_option("--multilayer-blend", args->blend,
+                        "multilayer: front-to-back blending of the traversed slices (§6.1, §7)")
+            ->check(CLI::IsMember({"over", "additive"}))
+            ->default_val("additive");
+        render.add_option("--multilayer-levels-out", args->levels_out,
+                          "multilayer: write each level's contribution (Fig. 7) to "
+                          "PREFIXlevelS.png and PREFIXbackground.png");
+    };
+    e.run = [args](const MethodInput& in, MethodOutput& out) {
+        return runMultilayer(*args, in, out);
+    };
+    return e;
+}
+
+} // namespace focal

@@ -1,0 +1,207 @@
+// The filtered multi-layer hierarchy of Selgrad et al. 2015 §5: fragment lists of level 0 (the
+// collected base, §4) filtered into levels 1..n by 2x2 mip steps (§5.1) and then 2x2 stack steps
+// (§5.2, the Y-map), each step a merge-sort-like combine that merges fragments of similar depth.
+// Also the per-frame level border table T (§6.1) and the truncation rule (§6.2) that both follow
+// from the thin lens. Consumes raster::FragmentLists and a ThinLens; produces FragmentLevels that
+// the caller owns (FragmentHierarchy keeps their memory between frames).
+//
+// Fragments are stored premultiplied: (α·c, α, d). The paper's merged colour c' is stored as α'c',
+// which makes the over operator and the additive combine of §5.1 plain sums (no 1/α').
+// Depth d is the distance along the view axis (raster::distanceFromDepth), float32.
+#pragma once
+
+#include <dof/lens.h>
+#include <raster/camera.h>
+#include <raster/fragment_lists.h>
+#include <raster/status.h>
+#include <raster/task_pool.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace dof {
+
+// One fragment of a level: premultiplied colour, opacity, view distance.
+struct LayerFragment {
+    float r = 0.0f; // α·red (linear)
+    float g = 0.0f;
+    float b = 0.0f;
+    float a = 0.0f;     // opacity α in [0,1]
+    float depth = 0.0f; // distance along the view axis (world units), > 0
+};
+
+enum class LevelKind : uint8_t {
+    Base,  // level 0: the collected lists (§4)
+    Mip,   // 2x2 lists of the level below merged into one, half the resolution (§5.1)
+    Stack, // 2x2 box without downsampling: the image grows by the dilation per level (§5.2)
+};
+
+// One level of the hierarchy: width x height cells, each a depth-sorted fragment list. Cells are
+// stored row by row (each row a consecutive array, the row's lists compacted with a prefix sum),
+// so one task can build one row without knowing the other rows' sizes.
+//
+// Geometry: cell (i, j) is centred at base-pixel coordinates
+//   (origin_x + i·spacing, origin_y + j·spacing)           (pixel p's centre is p + 1/2)
+// and holds a 2^S x 2^S box filter of the base level's point samples (S = index).
+struct FragmentLevel {
+    uint32_t index = 0;
+    LevelKind kind = LevelKind::Base;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    float spacing = 1.0f;  // base pixels between neighbouring cell centres (2^mip steps)
+    float origin_x = 0.5f; // base-pixel coordinate of cell (0, 0)'s centre
+    float origin_y = 0.5f;
+    uint32_t dilation = 0; // Stack: cells between the two taps combined per axis; Mip: 1
+    // Variance per axis, in base pixels², of the level's filter: the box of 2^S point samples,
+    // (4^S - 1)/12, plus the mean variance the bilinear lookup at pixel centres adds.
+    double filter_variance = 0.0;
+    double lookup_variance = 0.0;
+
+    std::vector<std::vector<LayerFragment>> rows; // one array per row of cells
+    std::vector<uint32_t> starts;                 // height * (width + 1): list of cell (i, j) is
+                                  // rows[j][starts[j*(width+1)+i] .. starts[j*(width+1)+i+1])
+    uint64_t fragments = 0; // total over all cells
+    uint32_t max_list_length = 0;
+    uint64_t truncated = 0; // merged fragments dropped by the §6.2 rule
+
+    double variance() const { return filter_variance + lookup_variance; }
+    const LayerFragment* list(uint32_t i, uint32_t j, uint32_t& count) const {
+        const size_t s = size_t(j) * (width + 1) + i;
+        count = starts[s + 1] - starts[s];
+        return rows[j].data() + starts[s];
+    }
+};
+
+// How the base level is filtered into levels 1..n (the Y-map of §5.2 / Schwarz & Stamminger
+// 2008): the first `mip_steps` levels are mip levels, the remaining `stack_steps` stack levels.
+// The paper's configurations: 1/3, 2/2 and 4/0.
+struct LevelPlan {
+    uint32_t mip_steps = 2;
+    uint32_t stack_steps = 2;
+    float epsilon = 0.2f; // §5.1 depth threshold, relative: merge while d <= d0·(1 + ε)
+    bool truncate = true; // §6.2: drop the depth intervals a level is never asked for
+    uint32_t levels() const { return mip_steps + stack_steps; }
+};
+
+constexpr uint32_t kMaxFilterLevels = 12;
+
+// The level border table T of §6.1, computed per frame. The paper matches Coc(z) = F|z - z_f|
+// with the level's filter size fs_S(z) = 2^S G z; in pixels that is |C(d)| = r_S with r_S
+// proportional to 2^S. focal matches second moments instead (Eq. in docs/dof/multilayer.md):
+// the aperture's per-axis second moment m2 (1/4 for the uniform disk) times C(d)² against the
+// level's variance V_S, so r_S = sqrt(V_S / m2) and
+//   z_{N,S} = d_f / (1 + r_S d_f / (E f_px)),   z_{F,S} = d_f / (1 - r_S d_f / (E f_px))
+// which are the paper's z_{N,S} = z_f / (1 + 2^S G/F), z_{F,S} = z_f / (1 - 2^S G/F) with
+// 2^S G/F = r_S d_f / (E f_px). z_{F,S} is +inf past the plateau (Fig. 8: r_S >= C(inf)).
+struct LevelBorders {
+    uint32_t levels = 0;          // n: levels 0..n
+    std::vector<double> radius;   // r_S, S = 0..n (r_0 = 0 for the unfiltered base)
+    std::vector<double> variance; // V_S
+    std::vector<float> z_near;    // z_{N,S}, S = 0..n (z_{N,0} = d_f)
+    std::vector<float> z_far;     // z_{F,S} (+inf past the plateau)
+    double second_moment = 0.25;  // m2 of the aperture, per axis, lens units²
+
+    // One traversal segment: depths [begin, end) use levels lo and hi = lo + 1 blended with
+    // t(d) = (m2 C(d)² - V_lo) / (V_hi - V_lo) in [0,1]; hi == lo past the top level.
+    struct Segment {
+        float begin = 0.0f;
+        float end = 0.0f;
+        uint32_t lo = 0;
+        uint32_t hi = 0;
+    };
+    // T as segments sorted by depth, near to far (the paper's (border, level) pairs).
+    std::vector<Segment> segments;
+};
+
+// Builds T for the levels' variances and the lens.
+LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
+                          double aperture_second_moment);
+
+// Interpolation weight of level hi at depth d in `segment` (0 when lo == hi).
+float levelBlend(const LevelBorders& borders, const ThinLens& lens,
+                 const LevelBorders::Segment& segment, float depth);
+
+// §6.2: true when level `level` (>= 1) is never asked for depth d, and no level above it needs
+// it either: z_{N,S-1} < d < z_{F,S-1}, the middle interval (which also covers the far field
+// past the plateau, Fig. 8).
+inline bool truncatedAt(const LevelBorders& borders, uint32_t level, float depth) {
+    return level >= 1 && depth > borders.z_near[level - 1] && depth < borders.z_far[level - 1];
+}
+
+// §5.1 merge of up to 8 depth-sorted lists into one sorted list, like merge sort's combine:
+// take the closest fragment d0 of all lists; from every list take its fragments with
+// d <= d0·(1 + ε) and blend them with the over operator (front to back, within one list); add
+// the lists' results weighted (the paper: 1/4 each for 2x2 lists, empty lists count as α' = 0);
+// emit (Σ w α'c', Σ w α', d0); repeat. Merged fragments with zero opacity are not emitted.
+// `keep(d0)` may drop a merged fragment (§6.2). Appends to `out`.
+struct ListRef {
+    const LayerFragment* data = nullptr;
+    uint32_t count = 0;
+    float weight = 0.0f;
+};
+template <class Keep>
+void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, Keep&& keep,
+                std::vector<LayerFragment>& out, uint64_t& dropped);
+
+// Level 0 from the collected lists: premultiplies colour by opacity and converts stored depth D
+// to view distance. Fragments with zero opacity are dropped.
+void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
+                   raster::TaskPool& pool, FragmentLevel& out);
+
+// The geometry (size, spacing, origin, dilation, variances) of every level of `plan` over a
+// base of width x height, without building them.
+std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const LevelPlan& plan);
+
+// Fills level `next` (geometry from planLevels) from `prev` (§5.1 mip or §5.2 stack step),
+// one task per row of cells, each cell merged in a fixed order: the bytes do not depend on the
+// thread count. With plan.truncate, merged fragments in next's middle interval are dropped.
+void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBorders& borders,
+                 raster::TaskPool& pool, FragmentLevel& next);
+
+// ---------------------------------------------------------------------------------------------
+
+template <class Keep>
+void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, Keep&& keep,
+                std::vector<LayerFragment>& out, uint64_t& dropped) {
+    uint32_t cursor[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    const float scale = 1.0f + epsilon;
+    for (;;) {
+        // Closest head over all lists (ties: the lower list index, a fixed order).
+        float d0 = 0.0f;
+        bool any = false;
+        for (uint32_t k = 0; k < list_count; ++k)
+            if (cursor[k] < lists[k].count) {
+                const float d = lists[k].data[cursor[k]].depth;
+                if (!any || d < d0)
+                    d0 = d, any = true;
+            }
+        if (!any)
+            return;
+        const float limit = d0 * scale;
+        LayerFragment merged;
+        merged.depth = d0;
+        for (uint32_t k = 0; k < list_count; ++k) {
+            // Over operator within list k, front to back (§5.1, first case).
+            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
+            uint32_t c = cursor[k];
+            const LayerFragment* l = lists[k].data;
+            for (; c < lists[k].count && l[c].depth <= limit; ++c) {
+                const float t = 1.0f - pa;
+                pr += t * l[c].r, pg += t * l[c].g, pb += t * l[c].b, pa += t * l[c].a;
+            }
+            cursor[k] = c;
+            // Additive blending across lists (§5.1, second case), weighted.
+            const float w = lists[k].weight;
+            merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
+        }
+        if (!(merged.a > 0.0f))
+            continue;
+        if (!keep(d0)) {
+            ++dropped;
+            continue;
+        }
+        out.push_back(merged);
+    }
+}
+
+} // namespace dof

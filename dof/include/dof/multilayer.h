@@ -1,0 +1,130 @@
+// `multilayer`: real-time depth of field by multi-layer filtering (Selgrad et al. 2015). Consumes
+// a view, a thin lens and a callback that collects per-pixel fragment lists (§4; the app passes
+// raster::Renderer::renderFragmentLists); builds the filtered level hierarchy (§5, see
+// dof/fragment_levels.h) and accumulates it per pixel guided by the circle of confusion (§6).
+// Produces a linear RGBA image owned by the caller. A Multilayer object keeps the lists and the
+// levels between frames (no reallocation once warm) and exposes them for stepping and dumps.
+//
+// Determinism: every cell and every output pixel is computed by one task in a fixed order
+// (merges break depth ties by list index), so the bytes do not depend on the thread count.
+#pragma once
+
+#include <dof/fragment_levels.h>
+#include <dof/lens.h>
+#include <raster/camera.h>
+#include <raster/fragment_lists.h>
+#include <raster/status.h>
+#include <raster/storage.h>
+#include <raster/task_pool.h>
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace dof {
+
+// How the slices met during the traversal are blended front to back (§6.1, §7).
+enum class LayerBlend : uint8_t {
+    Over,     // α-blending with the over operator, as for fragments of one list (§5.1)
+    Additive, // additive: Σ α_i c_i until the opacities sum to 1 (§7: avoids light leaks at
+              // grazing angles, over-estimates partly transparent middle layers)
+};
+
+struct MultilayerSettings {
+    uint32_t fragments_per_pixel = 4; // §4: closest N kept per pixel (paper: 3-4; 16); 0 = all
+    uint32_t mip_levels = 2;          // §5.2 Y-map: mip steps before the stack
+    int32_t stack_levels = -1;        // stack steps; -1 = auto: until the top level's filter
+                                      // matches the largest |C(d)| of the collected fragments
+    float epsilon = 0.2f;             // §5.1 depth threshold, relative to the depth
+    bool truncate = true;             // §6.2 fragment list truncation
+    LayerBlend blend = LayerBlend::Additive; // §7: the paper's general choice
+    // Per-axis second moment of the aperture in lens units² (1/4: uniform disk); the level
+    // borders match m2·C(d)² to the level's variance (docs/dof/multilayer.md).
+    double aperture_second_moment = 0.25;
+    // §4 storage of the collected lists: half colour + opacity, float depth (the paper's).
+    raster::ColorFormat color_format = raster::ColorFormat::Half;
+    raster::DepthFormat depth_format = raster::DepthFormat::Float32;
+    uint32_t node_capacity = 1u << 22; // initial fragment node pool (it grows on overflow)
+    // Also write each level's contribution to the image (Fig. 7) into MultilayerImage.
+    bool level_contributions = false;
+};
+
+// Rejects bad settings with a message naming the command-line option.
+raster::Status validate(const MultilayerSettings& settings);
+
+struct MultilayerLevelStats {
+    uint32_t index = 0;
+    LevelKind kind = LevelKind::Base;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    uint32_t dilation = 0;
+    uint64_t fragments = 0;
+    uint32_t max_list_length = 0;
+    double mean_list_length = 0.0; // fragments / cells
+    uint64_t truncated = 0;        // merged fragments dropped by §6.2
+    double radius_px = 0.0;        // r_S: the |C| this level matches (§6.1)
+    float z_near = 0.0f;           // z_{N,S}
+    float z_far = 0.0f;            // z_{F,S} (+inf past the plateau)
+};
+
+struct MultilayerStats {
+    double ms_collect = 0.0;          // §4: raster, sort/cap/compact, conversion to level 0
+    double ms_filter = 0.0;           // §5: levels 1..n
+    double ms_accumulate = 0.0;       // §6.1: traversal and blending
+    uint64_t fragments_collected = 0; // before the N cap
+    uint64_t fragments_kept = 0;      // after it
+    uint32_t max_list_length = 0;     // longest list before the cap
+    bool node_pool_grew = false;
+    uint32_t mip_levels = 0;
+    uint32_t stack_levels = 0;
+    float max_coc_px = 0.0f;     // largest |C(d)| over the collected fragments
+    uint64_t slices_blended = 0; // merged slices composited during the traversal
+    std::vector<MultilayerLevelStats> levels;
+};
+
+struct MultilayerImage {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<float> rgba;  // linear RGBA (alpha 1), top row first
+    std::vector<float> depth; // distance of the closest collected fragment (+inf: background)
+    // With settings.level_contributions: per level S the premultiplied RGB it adds to the
+    // final image (A = its share of the coverage), and the background's share last; they sum
+    // to rgba.
+    std::vector<std::vector<float>> level_rgba;
+};
+
+// Collects the fragment lists of the view (§4), e.g. raster::Renderer::renderFragmentLists.
+using CollectFn =
+    std::function<raster::Status(const raster::FragmentListDesc&, raster::FragmentLists&)>;
+
+class Multilayer {
+public:
+    // Renders one frame: collect, filter, accumulate. `background` is the colour behind every
+    // fragment (raster::Scene::background). Fails on invalid settings or lens, or when the
+    // collection fails; `out` is then unchanged.
+    raster::Status render(const raster::View& view, const ThinLens& lens, glm::vec3 background,
+                          const MultilayerSettings& settings, const CollectFn& collect,
+                          raster::TaskPool& pool, MultilayerImage& out,
+                          MultilayerStats* stats = nullptr);
+
+    // Runs §5 and §6 on lists collected elsewhere (stage-by-stage use and tests).
+    raster::Status renderFromLists(const raster::FragmentLists& lists, const raster::View& view,
+                                   const ThinLens& lens, glm::vec3 background,
+                                   const MultilayerSettings& settings, raster::TaskPool& pool,
+                                   MultilayerImage& out, MultilayerStats* stats = nullptr);
+
+    // The last frame's data.
+    const raster::FragmentLists& lists() const { return lists_; }
+    const std::vector<FragmentLevel>& levels() const { return levels_; }
+    const LevelBorders& borders() const { return borders_; }
+
+private:
+    raster::FragmentLists lists_;
+    std::vector<FragmentLevel> levels_;
+    LevelBorders borders_;
+};
+
+} // namespace dof

@@ -1,0 +1,354 @@
+#include <dof/multilayer.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace dof {
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The bilinear taps of one level along one axis for every pixel: cells i0, i1 with weight of i1.
+struct AxisTap {
+    uint32_t i0 = 0;
+    uint32_t i1 = 0;
+    float f = 0.0f;
+};
+
+std::vector<AxisTap> axisTaps(uint32_t pixels, float origin, float spacing, uint32_t cells) {
+    std::vector<AxisTap> taps(pixels);
+    const int64_t last = int64_t(cells) - 1;
+    for (uint32_t p = 0; p < pixels; ++p) {
+        const double u = (double(p) + 0.5 - double(origin)) / double(spacing);
+        const double fl = std::floor(u);
+        const int64_t i = int64_t(fl);
+        taps[p].i0 = uint32_t(std::clamp<int64_t>(i, 0, last));
+        taps[p].i1 = uint32_t(std::clamp<int64_t>(i + 1, 0, last));
+        taps[p].f = float(u - fl);
+    }
+    return taps;
+}
+
+// A list being traversed: level `level`, bilinear weight, cursor.
+struct Cursor {
+    const LayerFragment* data = nullptr;
+    uint32_t count = 0;
+    uint32_t next = 0;
+    float weight = 0.0f;
+};
+
+constexpr float kOpaque = 1.0f - 1.0f / 1024.0f; // stop once the pixel is this opaque
+
+struct Plan {
+    LevelPlan plan;
+    std::vector<FragmentLevel> geometry;
+};
+
+Plan makePlan(uint32_t width, uint32_t height, const MultilayerSettings& settings,
+              float max_coc_px) {
+    Plan p;
+    p.plan.mip_steps = settings.mip_levels;
+    p.plan.epsilon = settings.epsilon;
+    p.plan.truncate = settings.truncate;
+    if (settings.stack_levels >= 0) {
+        p.plan.stack_steps = uint32_t(settings.stack_levels);
+        p.geometry = planLevels(width, height, p.plan);
+        return p;
+    }
+    // Auto: the fewest stack steps whose top level matches the largest |C| in the frame.
+    for (uint32_t stack = 0;; ++stack) {
+        p.plan.stack_steps = stack;
+        p.geometry = planLevels(width, height, p.plan);
+        const double r_top =
+            std::sqrt(p.geometry.back().variance() / settings.aperture_second_moment);
+        if (r_top >= double(max_coc_px) || p.plan.levels() >= kMaxFilterLevels)
+            return p;
+    }
+}
+
+} // namespace
+
+raster::Status validate(const MultilayerSettings& s) {
+    using raster::Status;
+    if (s.fragments_per_pixel > 1024)
+        return Status::error("--fragments-per-pixel must be in [0, 1024] (0 keeps every "
+                             "fragment), got " +
+                             std::to_string(s.fragments_per_pixel));
+    if (s.stack_levels < -1)
+        return Status::error("--stack-levels must be a count >= 0 or 'auto'");
+    const uint32_t stack = s.stack_levels < 0 ? 0u : uint32_t(s.stack_levels);
+    if (s.mip_levels > kMaxFilterLevels || s.mip_levels + stack > kMaxFilterLevels)
+        return Status::error("--mip-levels + --stack-levels must be at most " +
+                             std::to_string(kMaxFilterLevels) + ", got " +
+                             std::to_string(s.mip_levels) + " + " + std::to_string(stack));
+    if (!std::isfinite(s.epsilon) || s.epsilon < 0.0f || s.epsilon > 10.0f)
+        return Status::error("--epsilon must be a relative depth threshold in [0, 10], got " +
+                             std::to_string(s.epsilon));
+    if (!std::isfinite(s.aperture_second_moment) || !(s.aperture_second_moment > 0.0))
+        return Status::error("the aperture's second moment must be positive and finite");
+    if (s.node_capacity == 0)
+        return Status::error("the fragment node capacity must be at least 1");
+    return {};
+}
+
+raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens,
+                                  glm::vec3 background, const MultilayerSettings& settings,
+                                  const CollectFn& collect, raster::TaskPool& pool,
+                                  MultilayerImage& out, MultilayerStats* stats) {
+    if (raster::Status s = validate(settings); !s.ok())
+        return s;
+    if (raster::Status s = validate(lens, view); !s.ok())
+        return s;
+    if (!collect)
+        return raster::Status::error("multilayer: no fragment-list collector");
+    // §4: collect, sort, keep the closest N, compact.
+    raster::FragmentListDesc desc;
+    desc.node_capacity = settings.node_capacity;
+    desc.max_per_pixel = settings.fragments_per_pixel;
+    desc.color_format = settings.color_format;
+    desc.depth_format = settings.depth_format;
+    desc.on_overflow = raster::OverflowPolicy::Grow;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (raster::Status s = collect(desc, lists_); !s.ok())
+        return s;
+    const double ms_lists = msSince(t0);
+    if (lists_.width != view.width || lists_.height != view.height)
+        return raster::Status::error("multilayer: the collected lists do not match the view");
+    raster::Status s = renderFromLists(lists_, view, lens, background, settings, pool, out, stats);
+    if (s.ok() && stats)
+        stats->ms_collect += ms_lists;
+    return s;
+}
+
+raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
+                                           const raster::View& view, const ThinLens& lens,
+                                           glm::vec3 background, const MultilayerSettings& settings,
+                                           raster::TaskPool& pool, MultilayerImage& out,
+                                           MultilayerStats* stats) {
+    if (raster::Status s = validate(settings); !s.ok())
+        return s;
+    if (raster::Status s = validate(lens, view); !s.ok())
+        return s;
+    const uint32_t width = lists.width;
+    const uint32_t height = lists.height;
+    if (width == 0 || height == 0 || lists.offsets.size() != size_t(width) * height + 1)
+        return raster::Status::error("multilayer: empty or malformed fragment lists");
+
+    // Level 0 (§4): premultiplied colour, view distance.
+    auto t0 = std::chrono::steady_clock::now();
+    if (levels_.empty())
+        levels_.resize(1);
+    makeBaseLevel(lists, view, pool, levels_[0]);
+    std::vector<float> row_min(height, std::numeric_limits<float>::infinity());
+    std::vector<float> row_max(height, 0.0f);
+    pool.parallelFor(height, [&](uint32_t y, uint32_t) {
+        for (const LayerFragment& f : levels_[0].rows[y]) {
+            row_min[y] = std::min(row_min[y], f.depth);
+            row_max[y] = std::max(row_max[y], f.depth);
+        }
+    });
+    float max_coc = 0.0f;
+    for (uint32_t y = 0; y < height; ++y)
+        if (row_max[y] > 0.0f)
+            max_coc = std::max({max_coc, std::fabs(cocRadiusPx(lens, row_min[y])),
+                                std::fabs(cocRadiusPx(lens, row_max[y]))});
+    const double ms_base = msSince(t0);
+
+    // §5: plan the Y-map, compute the border table T (§6.1), filter level by level.
+    t0 = std::chrono::steady_clock::now();
+    Plan plan = makePlan(width, height, settings, max_coc);
+    const uint32_t n = plan.plan.levels();
+    std::vector<double> variance;
+    for (const FragmentLevel& g : plan.geometry)
+        variance.push_back(g.variance());
+    borders_ = levelBorders(lens, variance, settings.aperture_second_moment);
+    levels_.resize(n + 1);
+    for (uint32_t s = 1; s <= n; ++s) {
+        FragmentLevel& l = levels_[s];
+        const FragmentLevel& g = plan.geometry[s];
+        l.index = g.index;
+        l.kind = g.kind;
+        l.width = g.width;
+        l.height = g.height;
+        l.spacing = g.spacing;
+        l.origin_x = g.origin_x;
+        l.origin_y = g.origin_y;
+        l.dilation = g.dilation;
+        l.filter_variance = g.filter_variance;
+        l.lookup_variance = g.lookup_variance;
+        filterLevel(levels_[s - 1], plan.plan, borders_, pool, l);
+    }
+    const double ms_filter = msSince(t0);
+
+    // §6.1: traverse T near to far per pixel, blend the slices met front to back.
+    t0 = std::chrono::steady_clock::now();
+    std::vector<std::vector<AxisTap>> tx(n + 1), ty(n + 1);
+    for (uint32_t s = 0; s <= n; ++s) {
+        const FragmentLevel& l = levels_[s];
+        tx[s] = axisTaps(width, l.origin_x, l.spacing, l.width);
+        ty[s] = axisTaps(height, l.origin_y, l.spacing, l.height);
+    }
+    out.width = width;
+    out.height = height;
+    out.rgba.assign(size_t(width) * height * 4, 0.0f);
+    out.depth.assign(size_t(width) * height, std::numeric_limits<float>::infinity());
+    const bool contributions = settings.level_contributions;
+    out.level_rgba.clear();
+    if (contributions)
+        out.level_rgba.assign(n + 2, std::vector<float>(size_t(width) * height * 4, 0.0f));
+    const float scale = 1.0f + settings.epsilon;
+    const bool additive = settings.blend == LayerBlend::Additive;
+    std::vector<uint64_t> row_slices(height, 0);
+    pool.parallelFor(height, [&](uint32_t y, uint32_t) {
+        Cursor cursors[kMaxFilterLevels + 1][4];
+        uint32_t cursor_count[kMaxFilterLevels + 1];
+        for (uint32_t x = 0; x < width; ++x) {
+            const size_t p = size_t(y) * width + x;
+            // Bilinear taps of every level at the pixel centre (zero weights skipped).
+            for (uint32_t s = 0; s <= n; ++s) {
+                const AxisTap ax = tx[s][x];
+                const AxisTap ay = ty[s][y];
+                const uint32_t cx[4] = {ax.i0, ax.i1, ax.i0, ax.i1};
+                const uint32_t cy[4] = {ay.i0, ay.i0, ay.i1, ay.i1};
+                const float w[4] = {(1.0f - ax.f) * (1.0f - ay.f), ax.f * (1.0f - ay.f),
+                                    (1.0f - ax.f) * ay.f, ax.f * ay.f};
+                uint32_t c = 0;
+                for (int k = 0; k < 4; ++k) {
+                    if (!(w[k] > 0.0f))
+                        continue;
+                    Cursor& cur = cursors[s][c++];
+                    cur.data = levels_[s].list(cx[k], cy[k], cur.count);
+                    cur.next = 0;
+                    cur.weight = w[k];
+                }
+                cursor_count[s] = c;
+            }
+            {
+                const Cursor& b = cursors[0][0];
+                if (b.count > 0)
+                    out.depth[p] = b.data[0].depth;
+            }
+            float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
+            for (const LevelBorders::Segment& seg : borders_.segments) {
+                if (ca >= kOpaque)
+                    break;
+                const uint32_t lv[2] = {seg.lo, seg.hi};
+                const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
+                // Skip what lies in front of the segment (not asked of this level there).
+                for (uint32_t c = 0; c < classes; ++c)
+                    for (uint32_t k = 0; k < cursor_count[lv[c]]; ++k) {
+                        Cursor& cur = cursors[lv[c]][k];
+                        while (cur.next < cur.count && cur.data[cur.next].depth < seg.begin)
+                            ++cur.next;
+                    }
+                while (ca < kOpaque) {
+                    // The closest fragment in the segment over both levels' taps.
+                    float d0 = seg.end;
+                    bool any = false;
+                    for (uint32_t c = 0; c < classes; ++c)
+                        for (uint32_t k = 0; k < cursor_count[lv[c]]; ++k) {
+                            const Cursor& cur = cursors[lv[c]][k];
+                            if (cur.next < cur.count && cur.data[cur.next].depth < d0)
+                                d0 = cur.data[cur.next].depth, any = true;
+                        }
+                    if (!any)
+                        break;
+                    // One slice: the §5.1 merge across taps and the two levels, weighted by
+                    // the bilinear weights and the level interpolation t(d0).
+                    const float limit = std::min(d0 * scale, std::nextafter(seg.end, 0.0f));
+                    const float t = levelBlend(borders_, lens, seg, d0);
+                    float part[2][4] = {{0.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
+                    for (uint32_t c = 0; c < classes; ++c) {
+                        const float level_weight = classes == 1 ? 1.0f : (c == 0 ? 1.0f - t : t);
+                        for (uint32_t k = 0; k < cursor_count[lv[c]]; ++k) {
+                            Cursor& cur = cursors[lv[c]][k];
+                            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
+                            for (; cur.next < cur.count && cur.data[cur.next].depth <= limit;
+                                 ++cur.next) {
+                                const LayerFragment& f = cur.data[cur.next];
+                                const float tr = 1.0f - pa;
+                                pr += tr * f.r, pg += tr * f.g, pb += tr * f.b, pa += tr * f.a;
+                            }
+                            const float w = level_weight * cur.weight;
+                            part[c][0] += w * pr, part[c][1] += w * pg, part[c][2] += w * pb;
+                            part[c][3] += w * pa;
+                        }
+                    }
+                    const float sa = part[0][3] + part[1][3];
+                    if (!(sa > 0.0f))
+                        continue;
+                    ++row_slices[y];
+                    // Front-to-back blending of the slice (§6.1).
+                    float k = 1.0f - ca;
+                    if (additive)
+                        k = std::min(sa, 1.0f - ca) / sa;
+                    cr += k * (part[0][0] + part[1][0]);
+                    cg += k * (part[0][1] + part[1][1]);
+                    cb += k * (part[0][2] + part[1][2]);
+                    ca += k * sa;
+                    if (contributions)
+                        for (uint32_t c = 0; c < classes; ++c) {
+                            float* o = out.level_rgba[lv[c]].data() + 4 * p;
+                            for (int i = 0; i < 4; ++i)
+                                o[i] += k * part[c][i];
+                        }
+                }
+            }
+            ca = std::min(ca, 1.0f);
+            const float rest = 1.0f - ca;
+            float* o = out.rgba.data() + 4 * p;
+            o[0] = cr + rest * background.r;
+            o[1] = cg + rest * background.g;
+            o[2] = cb + rest * background.b;
+            o[3] = 1.0f;
+            if (contributions) {
+                float* bg = out.level_rgba[n + 1].data() + 4 * p;
+                bg[0] = rest * background.r, bg[1] = rest * background.g;
+                bg[2] = rest * background.b, bg[3] = rest;
+            }
+        }
+    });
+    const double ms_accumulate = msSince(t0);
+
+    if (stats) {
+        MultilayerStats& st = *stats;
+        st = MultilayerStats{};
+        st.ms_collect = ms_base;
+        st.ms_filter = ms_filter;
+        st.ms_accumulate = ms_accumulate;
+        st.fragments_collected = lists.fragments_collected;
+        st.fragments_kept = lists.fragments_kept;
+        st.max_list_length = lists.max_list_length;
+        st.node_pool_grew = lists.grew;
+        st.mip_levels = plan.plan.mip_steps;
+        st.stack_levels = plan.plan.stack_steps;
+        st.max_coc_px = max_coc;
+        for (uint64_t c : row_slices)
+            st.slices_blended += c;
+        for (uint32_t s = 0; s <= n; ++s) {
+            const FragmentLevel& l = levels_[s];
+            MultilayerLevelStats ls;
+            ls.index = s;
+            ls.kind = l.kind;
+            ls.width = l.width;
+            ls.height = l.height;
+            ls.dilation = l.dilation;
+            ls.fragments = l.fragments;
+            ls.max_list_length = l.max_list_length;
+            ls.mean_list_length = double(l.fragments) / (double(l.width) * double(l.height));
+            ls.truncated = l.truncated;
+            ls.radius_px = borders_.radius[s];
+            ls.z_near = borders_.z_near[s];
+            ls.z_far = borders_.z_far[s];
+            st.levels.push_back(ls);
+        }
+    }
+    return {};
+}
+
+} // namespace dof

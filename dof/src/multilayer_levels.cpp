@@ -1,0 +1,214 @@
+#include <dof/fragment_levels.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace dof {
+namespace {
+
+// Mean over the pixel centres of one period of the variance a bilinear lookup adds per axis:
+// a lookup at fractional cell position f blends two cells `spacing` apart with weights (1-f, f),
+// which adds spacing² f(1-f).
+double lookupVariance(double origin, double spacing, uint32_t extent) {
+    const uint32_t period = std::max(1u, std::min(extent, uint32_t(spacing)));
+    double sum = 0.0;
+    for (uint32_t p = 0; p < period; ++p) {
+        const double u = (double(p) + 0.5 - origin) / spacing;
+        const double f = u - std::floor(u);
+        sum += f * (1.0 - f);
+    }
+    return spacing * spacing * sum / double(period);
+}
+
+void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_height) {
+    const double n = std::ldexp(1.0, int(level.index)); // 2^S point samples per axis
+    level.filter_variance = (n * n - 1.0) / 12.0;       // discrete box of 2^S samples
+    const double vx = lookupVariance(level.origin_x, level.spacing, base_width);
+    const double vy = lookupVariance(level.origin_y, level.spacing, base_height);
+    level.lookup_variance = 0.5 * (vx + vy);
+}
+
+} // namespace
+
+std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const LevelPlan& plan) {
+    std::vector<FragmentLevel> levels(plan.levels() + 1);
+    FragmentLevel& base = levels[0];
+    base.index = 0;
+    base.kind = LevelKind::Base;
+    base.width = width;
+    base.height = height;
+    base.spacing = 1.0f;
+    base.origin_x = base.origin_y = 0.5f;
+    base.dilation = 0;
+    for (uint32_t s = 1; s < levels.size(); ++s) {
+        const FragmentLevel& prev = levels[s - 1];
+        FragmentLevel& next = levels[s];
+        next.index = s;
+        if (s <= plan.mip_steps) {
+            // §5.1: cell i merges cells 2i and 2i+1; its centre is their mean.
+            next.kind = LevelKind::Mip;
+            next.width = (prev.width + 1) / 2;
+            next.height = (prev.height + 1) / 2;
+            next.spacing = 2.0f * prev.spacing;
+            next.origin_x = prev.origin_x + 0.5f * prev.spacing;
+            next.origin_y = prev.origin_y + 0.5f * prev.spacing;
+            next.dilation = 1;
+        } else {
+            // §5.2: cell i merges cells i-Δ and i (clamped), Δ = 2^(S-1) / spacing so that the
+            // box doubles to 2^S base pixels; the image grows by Δ (by 1 on the first step).
+            next.kind = LevelKind::Stack;
+            next.dilation =
+                std::max(1u, uint32_t(std::ldexp(1.0, int(s - 1)) / double(prev.spacing)));
+            next.width = prev.width + next.dilation;
+            next.height = prev.height + next.dilation;
+            next.spacing = prev.spacing;
+            const float shift = 0.5f * float(next.dilation) * prev.spacing;
+            next.origin_x = prev.origin_x - shift;
+            next.origin_y = prev.origin_y - shift;
+        }
+    }
+    for (FragmentLevel& l : levels)
+        finishGeometry(l, width, height);
+    levels[0].lookup_variance = 0.0; // pixel centres are the base cells' centres
+    return levels;
+}
+
+LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
+                          double aperture_second_moment) {
+    LevelBorders t;
+    t.levels = level_variance.empty() ? 0 : uint32_t(level_variance.size() - 1);
+    t.second_moment = aperture_second_moment;
+    t.variance = level_variance;
+    const double k = double(lens.aperture_radius) * double(lens.focal_length_px); // E f_px
+    const double inv_f = 1.0 / double(lens.focus_distance);
+    const float inf = std::numeric_limits<float>::infinity();
+    for (uint32_t s = 0; s <= t.levels; ++s) {
+        const double r = s == 0 ? 0.0 : std::sqrt(level_variance[s] / aperture_second_moment);
+        t.radius.push_back(r);
+        // Coc(z) = fs_S(z) (§6.1) with |C(d)| = E f_px |1/d_f - 1/d| = r_S.
+        if (!(k > 0.0)) {
+            t.z_near.push_back(s == 0 ? lens.focus_distance : 0.0f);
+            t.z_far.push_back(s == 0 ? lens.focus_distance : inf);
+            continue;
+        }
+        t.z_near.push_back(float(1.0 / (inv_f + r / k)));
+        const double inv_far = inv_f - r / k;
+        t.z_far.push_back(inv_far > 0.0 ? float(1.0 / inv_far) : inf);
+    }
+    // Segments near to far: [0, z_N,n) level n; [z_N,S+1, z_N,S) levels S, S+1 (S = n-1..1);
+    // [z_N,1, z_F,1) levels 0, 1; then the mirror image behind the focal plane.
+    const uint32_t n = t.levels;
+    auto add = [&](float begin, float end, uint32_t lo, uint32_t hi) {
+        if (end > begin)
+            t.segments.push_back({begin, end, lo, hi});
+    };
+    if (n == 0) {
+        add(0.0f, inf, 0, 0);
+        return t;
+    }
+    add(0.0f, t.z_near[n], n, n);
+    for (uint32_t s = n - 1; s >= 1; --s)
+        add(t.z_near[s + 1], t.z_near[s], s, s + 1);
+    add(t.z_near[1], t.z_far[1], 0, 1);
+    for (uint32_t s = 1; s < n; ++s)
+        add(t.z_far[s], t.z_far[s + 1], s, s + 1);
+    add(t.z_far[n], inf, n, n);
+    return t;
+}
+
+float levelBlend(const LevelBorders& borders, const ThinLens& lens,
+                 const LevelBorders::Segment& segment, float depth) {
+    if (segment.hi == segment.lo)
+        return 0.0f;
+    const double c = double(cocRadiusPx(lens, depth));
+    const double v = borders.second_moment * c * c;
+    const double v_lo = borders.variance[segment.lo];
+    const double v_hi = borders.variance[segment.hi];
+    const double t = (v - v_lo) / (v_hi - v_lo);
+    return float(std::clamp(t, 0.0, 1.0));
+}
+
+void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
+                   raster::TaskPool& pool, FragmentLevel& out) {
+    out.index = 0;
+    out.kind = LevelKind::Base;
+    out.width = lists.width;
+    out.height = lists.height;
+    out.rows.resize(lists.height);
+    out.starts.assign(size_t(lists.height) * (lists.width + 1), 0);
+    std::vector<uint32_t> longest(lists.height, 0);
+    pool.parallelFor(lists.height, [&](uint32_t y, uint32_t) {
+        std::vector<LayerFragment>& row = out.rows[y];
+        row.clear();
+        uint32_t* starts = out.starts.data() + size_t(y) * (lists.width + 1);
+        for (uint32_t x = 0; x < lists.width; ++x) {
+            const size_t p = size_t(y) * lists.width + x;
+            starts[x] = uint32_t(row.size());
+            for (uint32_t f = lists.offsets[p]; f < lists.offsets[p + 1]; ++f) {
+                const glm::vec4 c = lists.color.load(f);
+                const float d = raster::distanceFromDepth(view, lists.depth.load(f));
+                if (!(c.a > 0.0f) || !(d < std::numeric_limits<float>::infinity()))
+                    continue;
+                const float a = std::min(c.a, 1.0f);
+                row.push_back({a * c.r, a * c.g, a * c.b, a, d});
+            }
+            longest[y] = std::max(longest[y], uint32_t(row.size()) - starts[x]);
+        }
+        starts[lists.width] = uint32_t(row.size());
+    });
+    out.fragments = 0;
+    out.max_list_length = 0;
+    out.truncated = 0;
+    for (uint32_t y = 0; y < lists.height; ++y) {
+        out.fragments += out.rows[y].size();
+        out.max_list_length = std::max(out.max_list_length, longest[y]);
+    }
+}
+
+void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBorders& borders,
+                 raster::TaskPool& pool, FragmentLevel& next) {
+    next.rows.resize(next.height);
+    next.starts.assign(size_t(next.height) * (next.width + 1), 0);
+    std::vector<uint32_t> longest(next.height, 0);
+    std::vector<uint64_t> dropped(next.height, 0);
+    const bool mip = next.kind == LevelKind::Mip;
+    const int32_t delta = int32_t(next.dilation);
+    const int32_t max_x = int32_t(prev.width) - 1;
+    const int32_t max_y = int32_t(prev.height) - 1;
+    const uint32_t level = next.index;
+    pool.parallelFor(next.height, [&](uint32_t j, uint32_t) {
+        std::vector<LayerFragment>& row = next.rows[j];
+        row.clear();
+        uint32_t* starts = next.starts.data() + size_t(j) * (next.width + 1);
+        // Source rows and columns: mip 2j, 2j+1; stack j-Δ, j (border cells clamped, Fig. 4).
+        const int32_t y0 = std::clamp(mip ? 2 * int32_t(j) : int32_t(j) - delta, 0, max_y);
+        const int32_t y1 = std::clamp(mip ? 2 * int32_t(j) + 1 : int32_t(j), 0, max_y);
+        auto keep = [&](float d) { return !plan.truncate || !truncatedAt(borders, level, d); };
+        for (uint32_t i = 0; i < next.width; ++i) {
+            const int32_t x0 = std::clamp(mip ? 2 * int32_t(i) : int32_t(i) - delta, 0, max_x);
+            const int32_t x1 = std::clamp(mip ? 2 * int32_t(i) + 1 : int32_t(i), 0, max_x);
+            ListRef src[4];
+            const int32_t xs[4] = {x0, x1, x0, x1};
+            const int32_t ys[4] = {y0, y0, y1, y1};
+            for (int k = 0; k < 4; ++k) {
+                src[k].data = prev.list(uint32_t(xs[k]), uint32_t(ys[k]), src[k].count);
+                src[k].weight = 0.25f; // §5.1: α_merged = (α'_1 + ... + α'_4) / 4
+            }
+            starts[i] = uint32_t(row.size());
+            mergeLists(src, 4, plan.epsilon, keep, row, dropped[j]);
+            longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
+        }
+        starts[next.width] = uint32_t(row.size());
+    });
+    next.fragments = 0;
+    next.max_list_length = 0;
+    next.truncated = 0;
+    for (uint32_t j = 0; j < next.height; ++j) {
+        next.fragments += next.rows[j].size();
+        next.max_list_length = std::max(next.max_list_length, longest[j]);
+        next.truncated += dropped[j];
+    }
+}
+
+} // namespace dof

@@ -1,0 +1,402 @@
+// Tests of multi-layer filtering (dof/multilayer.h, dof/fragment_levels.h; Selgrad et al. 2015):
+// the §5.1 merge, the §6.1 border table, analytic DOF checks and determinism.
+#include "dof_test_util.h"
+
+#include <dof/fragment_levels.h>
+#include <dof/multilayer.h>
+#include <raster/fragment_lists.h>
+#include <raster/renderer.h>
+#include <scenes/builtin.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace focal::test {
+namespace {
+
+constexpr uint32_t kW = 64, kH = 64;
+constexpr float kFocus = 100.0f; // pixelView: f_px = d_f = 100
+
+raster::View testView(uint32_t w = kW, uint32_t h = kH) {
+    return pixelView(w, h, kFocus);
+}
+
+struct MlRun {
+    dof::MultilayerImage image;
+    dof::MultilayerStats stats;
+    std::vector<dof::FragmentLevel> levels;
+};
+
+MlRun runMultilayer(const raster::Scene& scene, const raster::View& view, const dof::ThinLens& lens,
+                    dof::MultilayerSettings settings = {}, uint32_t threads = 0) {
+    raster::TaskPool pool(threads);
+    raster::Renderer renderer(pool);
+    dof::Multilayer ml;
+    MlRun run;
+    const dof::CollectFn collect = [&](const raster::FragmentListDesc& desc,
+                                       raster::FragmentLists& lists) {
+        return renderer.renderFragmentLists(scene, view, {}, desc, lists);
+    };
+    const raster::Status s =
+        ml.render(view, lens, scene.background, settings, collect, pool, run.image, &run.stats);
+    EXPECT_TRUE(s.ok()) << s.message();
+    run.levels = ml.levels();
+    return run;
+}
+
+float channel(const dof::MultilayerImage& img, uint32_t x, uint32_t y, int c) {
+    return img.rgba[(size_t(y) * img.width + x) * 4 + size_t(c)];
+}
+
+uint64_t hashImage(const dof::MultilayerImage& img) {
+    uint64_t h = 1469598103934665603ull;
+    for (float v : img.rgba) {
+        uint32_t bits = 0;
+        std::memcpy(&bits, &v, 4);
+        for (int i = 0; i < 4; ++i) {
+            h ^= (bits >> (8 * i)) & 0xffu;
+            h *= 1099511628211ull;
+        }
+    }
+    return h;
+}
+
+raster::Scene checkerWall(float d) {
+    raster::Scene scene;
+    const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
+    const int32_t dark = addMaterial(scene, flatMaterial({0.1f, 0.3f, 0.05f, 1.0f}));
+    const float s = d / kFocus;
+    for (int j = -12; j < 12; ++j)
+        for (int i = -12; i < 12; ++i)
+            addQuad(scene, float(4 * i) * s, float(4 * j) * s, float(4 * i + 4) * s,
+                    float(4 * j + 4) * s, d, ((i + j) & 1) ? white : dark);
+    return scene;
+}
+
+// --- §5.1 merge ---------------------------------------------------------------------------
+
+dof::LayerFragment frag(float c, float a, float d) {
+    return {a * c, a * c, a * c, a, d};
+}
+
+TEST(Multilayer, MergeOpaqueStaysOpaqueAndSilhouettesTurnTransparent) {
+    const dof::LayerFragment l0[] = {frag(1.0f, 1.0f, 10.0f)};
+    const dof::LayerFragment l1[] = {frag(0.5f, 1.0f, 10.1f)};
+    const dof::LayerFragment l2[] = {frag(0.0f, 1.0f, 10.05f)};
+    const dof::LayerFragment l3[] = {frag(0.25f, 1.0f, 10.0f)};
+    dof::ListRef lists[4] = {{l0, 1, 0.25f}, {l1, 1, 0.25f}, {l2, 1, 0.25f}, {l3, 1, 0.25f}};
+    std::vector<dof::LayerFragment> out;
+    uint64_t dropped = 0;
+    auto all = [](float) { return true; };
+    dof::mergeLists(lists, 4, 0.02f, all, out, dropped);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_FLOAT_EQ(out[0].a, 1.0f);         // opaque stays opaque
+    EXPECT_FLOAT_EQ(out[0].r, 1.75f / 4.0f); // mean colour
+    EXPECT_FLOAT_EQ(out[0].depth, 10.0f);    // the closest fragment starts the group
+
+    // Silhouette: two of four lists empty -> half coverage.
+    lists[2].count = 0;
+    lists[3].count = 0;
+    out.clear();
+    dof::mergeLists(lists, 4, 0.02f, all, out, dropped);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_FLOAT_EQ(out[0].a, 0.5f);
+}
+
+TEST(Multilayer, MergeUsesOverWithinAListAndSplitsBeyondEpsilon) {
+    // List 0: two half-transparent fragments within ε, then one far behind.
+    const dof::LayerFragment l0[] = {frag(1.0f, 0.5f, 10.0f), frag(0.0f, 0.5f, 10.1f),
+                                     frag(1.0f, 1.0f, 20.0f)};
+    dof::ListRef lists[1] = {{l0, 3, 1.0f}};
+    std::vector<dof::LayerFragment> out;
+    uint64_t dropped = 0;
+    dof::mergeLists(
+        lists, 1, 0.02f, [](float) { return true; }, out, dropped);
+    ASSERT_EQ(out.size(), 2u);
+    // α' = 1 - (1 - αa)(1 - αb) = 0.75; α'c' = αa ca + (1 - αa) αb cb = 0.5.
+    EXPECT_FLOAT_EQ(out[0].a, 0.75f);
+    EXPECT_FLOAT_EQ(out[0].r, 0.5f);
+    EXPECT_FLOAT_EQ(out[1].depth, 20.0f);
+    // ε = 0: three groups; a keep() that drops the far one counts it.
+    out.clear();
+    dof::mergeLists(
+        lists, 1, 0.0f, [](float d) { return d < 15.0f; }, out, dropped);
+    EXPECT_EQ(out.size(), 2u);
+    EXPECT_EQ(dropped, 1u);
+}
+
+// --- §6.1 border table --------------------------------------------------------------------
+
+TEST(Multilayer, BorderTableSolvesCocEqualsFilterSize) {
+    const raster::View view = testView();
+    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, kFocus); // C(inf) = 12 px
+    const std::vector<dof::FragmentLevel> levels = dof::planLevels(kW, kH, {2, 3, 0.02f, true});
+    std::vector<double> var;
+    for (const dof::FragmentLevel& l : levels)
+        var.push_back(l.variance());
+    const dof::LevelBorders t = dof::levelBorders(lens, var, 0.25);
+    ASSERT_EQ(t.levels, 5u);
+    for (uint32_t s = 1; s <= t.levels; ++s) {
+        EXPECT_GT(var[s], var[s - 1]);
+        // |C(z_N,S)| = r_S and, where finite, |C(z_F,S)| = r_S.
+        EXPECT_NEAR(std::fabs(dof::cocRadiusPx(lens, t.z_near[s])), t.radius[s], 1e-3);
+        EXPECT_LT(t.z_near[s], t.z_near[s - 1]);
+        if (std::isfinite(t.z_far[s]))
+            EXPECT_NEAR(std::fabs(dof::cocRadiusPx(lens, t.z_far[s])), t.radius[s], 1e-3);
+        else
+            EXPECT_GE(t.radius[s], 12.0); // plateau (Fig. 8)
+        // The paper's closed form with 2^S G / F = r_S d_f / (E f_px).
+        const double q = t.radius[s] * double(kFocus) / (12.0 * 100.0);
+        EXPECT_NEAR(double(t.z_near[s]), double(kFocus) / (1.0 + q), 1e-3);
+    }
+    // Segments tile (0, inf) near to far without gaps.
+    ASSERT_FALSE(t.segments.empty());
+    EXPECT_EQ(t.segments.front().begin, 0.0f);
+    EXPECT_TRUE(std::isinf(t.segments.back().end));
+    for (size_t i = 1; i < t.segments.size(); ++i)
+        EXPECT_EQ(t.segments[i].begin, t.segments[i - 1].end);
+    // Stack levels keep the mip spacing and grow by their dilation (1, then 2, 4).
+    EXPECT_EQ(levels[3].kind, dof::LevelKind::Stack);
+    EXPECT_EQ(levels[3].dilation, 1u);
+    EXPECT_EQ(levels[4].dilation, 2u);
+    EXPECT_EQ(levels[3].width, levels[2].width + 1);
+    EXPECT_EQ(levels[4].width, levels[3].width + 2);
+    EXPECT_EQ(levels[2].width, kW / 4);
+}
+
+// --- analytic DOF checks ------------------------------------------------------------------
+
+TEST(Multilayer, InFocusWallIsUnchanged) {
+    const raster::View view = testView();
+    const raster::Scene scene = checkerWall(kFocus);
+    const raster::Frame pinhole = render(scene, view);
+    dof::MultilayerSettings settings;
+    settings.color_format = raster::ColorFormat::Float32;
+    const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus), settings);
+    float max_diff = 0.0f;
+    for (size_t i = 0; i < pinhole.color.size(); ++i)
+        max_diff = std::max(max_diff, std::fabs(pinhole.color[i] - ml.image.rgba[i]));
+    EXPECT_LT(max_diff, 1e-5f);
+    // Half storage: within half precision.
+    const MlRun half = runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus));
+    max_diff = 0.0f;
+    for (size_t i = 0; i < pinhole.color.size(); ++i)
+        max_diff = std::max(max_diff, std::fabs(pinhole.color[i] - half.image.rgba[i]));
+    EXPECT_LT(max_diff, 1e-3f);
+}
+
+TEST(Multilayer, OffFocusWallIsBlurred) {
+    const raster::View view = testView();
+    const raster::Scene scene = checkerWall(200.0f);
+    const raster::Frame pinhole = render(scene, view);
+    const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus));
+    float max_diff = 0.0f;
+    for (size_t i = 0; i < pinhole.color.size(); ++i)
+        max_diff = std::max(max_diff, std::fabs(pinhole.color[i] - ml.image.rgba[i]));
+    EXPECT_GT(max_diff, 0.2f);
+}
+
+TEST(Multilayer, ConstantImageStaysConstant) {
+    for (float d : {200.0f / 3.0f, 200.0f}) {
+        raster::Scene scene;
+        scene.background = {0.9f, 0.1f, 0.1f};
+        const int32_t m = addMaterial(scene, flatMaterial({0.25f, 0.5f, 0.75f, 1.0f}));
+        const float s = d / kFocus;
+        addQuad(scene, -100.0f * s, -100.0f * s, 100.0f * s, 100.0f * s, d, m);
+        const raster::View view = testView();
+        dof::MultilayerSettings settings;
+        settings.color_format = raster::ColorFormat::Float32;
+        for (uint32_t mip : {0u, 2u, 4u}) {
+            settings.mip_levels = mip;
+            const MlRun ml =
+                runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus), settings);
+            for (uint32_t y = 0; y < kH; ++y)
+                for (uint32_t x = 0; x < kW; ++x) {
+                    ASSERT_NEAR(channel(ml.image, x, y, 0), 0.25f, 1e-5f) << x << "," << y;
+                    ASSERT_NEAR(channel(ml.image, x, y, 1), 0.5f, 1e-5f);
+                    ASSERT_NEAR(channel(ml.image, x, y, 2), 0.75f, 1e-5f);
+                }
+        }
+    }
+}
+
+TEST(Multilayer, OpaqueSurfacesStayOpaqueThroughTheLevels) {
+    // A wall covering the whole view behind the focal plane and a small quad in front of it:
+    // every cell of every level holds the wall with opacity 1 (over-composited list), also
+    // where the quad's silhouette makes its own fragment partly transparent.
+    const raster::View view = testView();
+    raster::Scene scene = checkerWall(200.0f);
+    const int32_t red = addMaterial(scene, flatMaterial({1.0f, 0.0f, 0.0f, 1.0f}));
+    addQuad(scene, -10.0f, -10.0f, 10.0f, 10.0f, 60.0f, red);
+    dof::MultilayerSettings settings;
+    settings.truncate = false;
+    settings.stack_levels = 3;
+    const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus), settings);
+    ASSERT_EQ(ml.levels.size(), 6u);
+    bool partial_seen = false;
+    for (const dof::FragmentLevel& l : ml.levels)
+        for (uint32_t j = 0; j < l.height; ++j)
+            for (uint32_t i = 0; i < l.width; ++i) {
+                uint32_t count = 0;
+                const dof::LayerFragment* f = l.list(i, j, count);
+                float a = 0.0f;
+                for (uint32_t k = 0; k < count; ++k) {
+                    a += (1.0f - a) * f[k].a;
+                    if (f[k].a < 0.99f)
+                        partial_seen = true;
+                }
+                ASSERT_NEAR(a, 1.0f, 1e-5f) << "level " << l.index << " cell " << i << "," << j;
+                ASSERT_NEAR(f[count - 1].depth, 200.0f, 0.5f); // the wall is last
+            }
+    EXPECT_TRUE(partial_seen); // the quad's silhouette
+}
+
+// Variance of the line-spread function of a vertical step edge in one row (see accum_test.cpp):
+// a uniform disk of radius R has an LSF with variance R^2 / 4.
+double edgeVariance(const dof::MultilayerImage& f, uint32_t row) {
+    double sum = 0.0, mean = 0.0, var = 0.0;
+    std::vector<double> lsf(f.width, 0.0);
+    for (uint32_t x = 1; x < f.width; ++x) {
+        lsf[x] = double(channel(f, x, row, 0)) - double(channel(f, x - 1, row, 0));
+        sum += lsf[x];
+        mean += lsf[x] * double(x);
+    }
+    mean /= sum;
+    for (uint32_t x = 1; x < f.width; ++x)
+        var += lsf[x] * (double(x) - mean) * (double(x) - mean);
+    return var / sum;
+}
+
+TEST(Multilayer, BlurSizeTracksTheLens) {
+    // The blur radius of a step edge, from the LSF variance minus the 1/12 px² of point
+    // sampling, matches |C(d)|. Mip levels blur edges that fall on a cell boundary less than
+    // edges inside a cell (the mip-map's pixel structure, §5.2 Fig. 3), so the variance is
+    // averaged over four edge positions one pixel apart.
+    const raster::View view = testView();
+    for (float aperture : {6.0f, 12.0f, 24.0f})
+        for (float d : {200.0f / 3.0f, 200.0f}) {
+            const dof::ThinLens lens = dof::makeThinLens(view, aperture, kFocus);
+            const double coc = double(std::fabs(dof::cocRadiusPx(lens, d)));
+            for (uint32_t mip : {0u, 2u}) {
+                double var = 0.0;
+                for (int shift = 0; shift < 4; ++shift) {
+                    raster::Scene scene;
+                    const int32_t white =
+                        addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
+                    const int32_t black =
+                        addMaterial(scene, flatMaterial({0.0f, 0.0f, 0.0f, 1.0f}));
+                    const float s = d / kFocus;
+                    const float x0 = float(shift) * s;
+                    addQuad(scene, x0, -200.0f * s, 200.0f * s, 200.0f * s, d, white);
+                    addQuad(scene, -200.0f * s, -200.0f * s, x0, 200.0f * s, d, black);
+                    dof::MultilayerSettings settings;
+                    settings.mip_levels = mip;
+                    const MlRun ml = runMultilayer(scene, view, lens, settings);
+                    for (uint32_t row : {20u, 32u, 44u})
+                        var += edgeVariance(ml.image, row) / 12.0;
+                }
+                const double radius = 2.0 * std::sqrt(std::max(0.0, var - 1.0 / 12.0));
+                EXPECT_NEAR(radius, coc, 0.1 * coc + 0.25)
+                    << "E = " << aperture << " d = " << d << " mip " << mip;
+            }
+        }
+}
+
+TEST(Multilayer, TruncationKeepsTheImageAndShortensLists) {
+    const raster::View view = testView();
+    raster::Scene scene = checkerWall(200.0f);
+    const int32_t red = addMaterial(scene, flatMaterial({1.0f, 0.0f, 0.0f, 1.0f}));
+    addQuad(scene, -10.0f, -10.0f, 10.0f, 10.0f, 60.0f, red);
+    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, kFocus);
+    dof::MultilayerSettings settings;
+    settings.stack_levels = 3;
+    settings.truncate = false;
+    const MlRun full = runMultilayer(scene, view, lens, settings);
+    settings.truncate = true;
+    const MlRun cut = runMultilayer(scene, view, lens, settings);
+    uint64_t full_frags = 0, cut_frags = 0, dropped = 0;
+    for (const dof::MultilayerLevelStats& l : full.stats.levels)
+        full_frags += l.fragments;
+    for (const dof::MultilayerLevelStats& l : cut.stats.levels)
+        cut_frags += l.fragments, dropped += l.truncated;
+    EXPECT_LT(cut_frags, full_frags);
+    EXPECT_GT(dropped, 0u);
+    float max_diff = 0.0f;
+    for (size_t i = 0; i < full.image.rgba.size(); ++i)
+        max_diff = std::max(max_diff, std::fabs(full.image.rgba[i] - cut.image.rgba[i]));
+    EXPECT_LT(max_diff, 1e-6f);
+}
+
+TEST(Multilayer, AutoLevelsCoverTheLargestCoc) {
+    const raster::View view = testView();
+    const raster::Scene scene = checkerWall(200.0f / 3.0f); // C = -12 px for E = 24
+    const dof::ThinLens lens = dof::makeThinLens(view, 24.0f, kFocus);
+    const MlRun ml = runMultilayer(scene, view, lens);
+    EXPECT_NEAR(ml.stats.max_coc_px, 12.0f, 1e-3f);
+    ASSERT_FALSE(ml.stats.levels.empty());
+    EXPECT_GE(ml.stats.levels.back().radius_px, 12.0);
+    EXPECT_LT(ml.stats.levels[ml.stats.levels.size() - 2].radius_px, 12.0);
+    EXPECT_EQ(ml.stats.mip_levels, 2u);
+}
+
+TEST(Multilayer, TransparentPaneTintsWhatIsBehindIt) {
+    // A BLEND pane (α = 0.5) in focus in front of an in-focus wall: over-blended, unblurred.
+    const raster::View view = testView();
+    raster::Scene scene = checkerWall(kFocus);
+    const int32_t glass =
+        addMaterial(scene, flatMaterial({0.0f, 0.0f, 1.0f, 0.5f}, raster::AlphaMode::Blend));
+    addQuad(scene, -100.0f * 0.99f, -100.0f * 0.99f, 100.0f * 0.99f, 100.0f * 0.99f, kFocus * 0.99f,
+            glass);
+    const raster::Frame wall = render(checkerWall(kFocus), view);
+    dof::MultilayerSettings settings;
+    settings.color_format = raster::ColorFormat::Float32;
+    settings.epsilon = 0.001f;
+    const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 1.0f, kFocus), settings);
+    for (uint32_t y = 4; y < kH; y += 9)
+        for (uint32_t x = 4; x < kW; x += 9) {
+            const glm::vec4 w = pixel(wall, x, y);
+            EXPECT_NEAR(channel(ml.image, x, y, 0), 0.5f * w.r, 2e-3f);
+            EXPECT_NEAR(channel(ml.image, x, y, 2), 0.5f + 0.5f * w.b, 2e-3f);
+        }
+}
+
+TEST(Multilayer, DeterministicAcrossThreadCounts) {
+    raster::Result<raster::Scene> scene = scenes::makeBuiltinScene("railing");
+    ASSERT_TRUE(scene.ok());
+    const raster::View view = raster::viewFromCamera(scene->cameras[0], 192, 108);
+    const dof::ThinLens lens =
+        dof::makeThinLens(view, scene->lens->aperture_radius, scene->lens->focus_distance);
+    for (const char* config : {"2/auto", "0/3", "4/0"}) {
+        dof::MultilayerSettings settings;
+        settings.mip_levels = uint32_t(config[0] - '0');
+        settings.stack_levels = config[2] == 'a' ? -1 : int32_t(config[2] - '0');
+        const uint64_t h0 = hashImage(runMultilayer(*scene, view, lens, settings, 0).image);
+        for (uint32_t threads : {1u, 2u, 3u, 8u})
+            EXPECT_EQ(hashImage(runMultilayer(*scene, view, lens, settings, threads).image), h0)
+                << config << " threads " << threads;
+    }
+}
+
+TEST(Multilayer, BadSettingsNameTheOption) {
+    dof::MultilayerSettings s;
+    s.epsilon = -1.0f;
+    raster::Status st = dof::validate(s);
+    EXPECT_FALSE(st.ok());
+    EXPECT_NE(st.message().find("--epsilon"), std::string::npos);
+    s = {};
+    s.mip_levels = 10;
+    s.stack_levels = 10;
+    st = dof::validate(s);
+    EXPECT_NE(st.message().find("--mip-levels"), std::string::npos);
+    s = {};
+    s.fragments_per_pixel = 5000;
+    EXPECT_NE(dof::validate(s).message().find("--fragments-per-pixel"), std::string::npos);
+    s = {};
+    s.epsilon = NAN;
+    EXPECT_FALSE(dof::validate(s).ok());
+}
+
+} // namespace
+} // namespace focal::test
