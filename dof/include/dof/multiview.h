@@ -1,0 +1,162 @@
+// `multiview`: depth of field by multiview synthesis from a layered image-based scene
+// (Lee, Eisemann & Seidel 2009). Consumes a pinhole frame and a raster::LayeredTarget rendered
+// through the lens centre (§4.1-4.2; or render callbacks that produce them), the thin lens and a
+// lens sample set; traces N lens rays per pixel through the layers' height fields (§4.3, Eq. 2-3)
+// with N-buffer culling (§4.3), approximate cone tracing (§4.4), jittered lens sampling (§4.5)
+// and optional view-dependent shading per ray (§5). Produces linear RGBA owned by the caller;
+// scratch (N-buffers, mipmaps) lives in the MultiviewScratch the caller may keep between frames.
+//
+// Determinism: the image is split into tiles; each output pixel is computed by one task, its
+// rays traced in sample order and summed in a fixed order; counters are summed per tile, then in
+// tile order. Jitter is a pure function of (pixel, sample index, seed). Output bytes do not
+// depend on the thread count.
+#pragma once
+
+#include <dof/layer_spacing.h>
+#include <dof/lens.h>
+#include <dof/lens_samples.h>
+#include <dof/n_buffer.h>
+#include <raster/camera.h>
+#include <raster/frame.h>
+#include <raster/layered_target.h>
+#include <raster/renderer.h>
+#include <raster/scene.h>
+#include <raster/status.h>
+#include <raster/task_pool.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace dof {
+
+// Per-pixel variation of the lens samples (§4.5). Every choice is a pure function of the pixel,
+// the sample index and MultiviewSettings::seed.
+enum class JitterMode : uint8_t {
+    None,   // every pixel uses the shared set (like accum): aliasing along edges
+    Noise,  // the paper's trade-off: a per-pixel 4-component noise texel; its 16 pairwise
+            // combinations (n_i, n_j) offset 1/16th of the samples each, scaled by lambda/2
+    Halton, // the paper's best quality: a 2N-sample sequence, each pixel takes N consecutive
+            // samples from an offset in [0, 2N-1] (needs MultiviewSettings::sequence_2n)
+    Rotate, // a per-pixel Cranley-Patterson rotation of the pattern (LensSampleSet::sample(x,y,i))
+};
+
+// What happens to a lens ray whose path leaves the image (§4.3 "Handling Off-Screen Pixels").
+enum class OffscreenPolicy : uint8_t {
+    Discard, // the paper: the ray is dropped and the remaining rays' weights renormalised
+    Clamp,   // the ray reads the nearest border texel instead
+};
+
+// An equirectangular environment map in linear RGB for reflections (§5, Fig. 9): row 0 is the
+// +y pole; u = 0.5 + atan2(dir.x, -dir.z) / 2pi. Plain data (loaded by the app).
+struct EnvironmentMap {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<float> rgb; // width*height*3
+    float intensity = 1.0f;
+};
+
+struct MultiviewSettings {
+    float layer_spacing_px = 2.0f; // delta of §4.1 (used when layers == 0)
+    uint32_t layers = 0;           // M; 0: from layer_spacing_px (capped at raster::kMaxLayers)
+    float overlap = 0.1f;          // §4.2: each layer widened by this fraction (in 1/d)
+    raster::LayerRouting routing = raster::LayerRouting::MaxVertexDepth;
+    raster::ColorFormat color_format = raster::ColorFormat::Half;
+    raster::DepthFormat depth_format = raster::DepthFormat::Float32;
+    uint32_t iterations = 3;   // false-position steps per layer (§4.3: "three ... enough")
+    uint32_t refine_steps = 4; // binary-search steps after the bracketing (§4.3)
+    bool culling = true;       // §4.3 early layer culling with N-buffers (lossless)
+    bool cone = true;          // §4.4 approximate cone tracing
+    JitterMode jitter = JitterMode::Noise;
+    uint32_t seed = 0; // jitter key
+    OffscreenPolicy offscreen = OffscreenPolicy::Discard;
+    bool view_dependent = false; // §5: shade each hit from its own lens point (needs G-buffer)
+    const EnvironmentMap* env_map = nullptr; // §5 reflections (implies a G-buffer)
+    // For JitterMode::Halton: 2N samples of the same pattern family and aperture as the main set.
+    const LensSampleSet* sequence_2n = nullptr;
+    uint32_t tile_size = 16; // output tile (the unit of parallel work and of tile culling)
+};
+
+struct MultiviewStats {
+    // Counts (deterministic).
+    uint32_t layers = 0;               // M
+    uint32_t layers_empty = 0;         // layers with no fragment (skipped entirely)
+    float delta_px = 0.0f;             // spacing used
+    bool budget_limited = false;       // the spacing needed more than raster::kMaxLayers layers
+    float d_near = 0.0f, d_far = 0.0f; // visible depth range (§4.1)
+    float lambda = 0.0f;         // mean nearest-neighbour distance of the lens samples (§4.4)
+    uint32_t nbuffer_levels = 0; // most levels any layer needed
+    uint32_t mip_levels = 0;
+    uint64_t rays = 0;               // lens rays traced (pixels x N)
+    uint64_t rays_discarded = 0;     // left the image (OffscreenPolicy::Discard)
+    uint64_t rays_background = 0;    // passed every layer without a hit
+    uint64_t layer_tests = 0;        // ray-segment/height-field tests run
+    uint64_t layer_culled_pixel = 0; // (pixel, layer) pairs skipped by the N-buffer query
+    uint64_t layer_culled_tile = 0;  // (tile, layer) pairs skipped by one query for the tile
+    uint64_t layer_culled_ray = 0;   // (ray, layer) pairs skipped by a query on the ray's path
+    uint64_t cone_partial = 0;       // hits whose cone coverage v1 < 1 continued the traversal
+    uint64_t texel_fetches = 0;      // height-field lookups
+    uint64_t layered_bytes = 0;      // memory of the layered target
+    uint64_t scratch_bytes = 0;      // N-buffers + mipmaps
+    // Times (not deterministic).
+    double ms_pinhole = 0.0;       // pinhole render for the depth range
+    double ms_decomposition = 0.0; // layered rendering (§4.2)
+    double ms_nbuffer = 0.0;
+    double ms_mipmaps = 0.0;
+    double ms_tracing = 0.0;
+};
+
+// Reusable scratch: per-layer float depths, N-buffers and coverage mipmaps.
+struct MultiviewScratch {
+    std::vector<std::vector<float>> depth; // per layer, stored D; kEmptyDepth where empty
+    std::vector<NBuffer> nbuffers;         // per layer (empty when the layer is empty or culling
+                                           // is off)
+    // per layer, per level >= 1: premultiplied RGBA (alpha = coverage), level sizes halve
+    std::vector<std::vector<std::vector<float>>> mips;
+    std::vector<uint32_t> mip_width, mip_height; // per level (level 0 = image)
+};
+
+// The layered target's description for a depth range (§4.1 spacing + §4.2 options).
+raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& lens,
+                                                             const DepthRange& range,
+                                                             const MultiviewSettings& settings,
+                                                             LayerSpacing* spacing_out = nullptr);
+
+// Mean distance from each sample to its nearest neighbour in lens units: the lambda of §4.4.
+float meanNeighbourDistance(const LensSampleSet& samples);
+
+// The view-dependent shading context (§5): the scene whose lights shade each hit with the
+// rasterizer's model (raster::SurfaceShader), plus MultiviewSettings::env_map reflections.
+struct ShadingInputs {
+    const raster::Scene* scene = nullptr;
+};
+
+// §4.3-§5 on given layers: traces every pixel's lens rays and writes linear RGBA into `rgba`
+// (resized to width*height*4, alpha 1). `pinhole` supplies the colour of pixels whose rays were
+// all discarded; `background` is what rays that miss every layer see. Fails on invalid settings
+// (messages name the options) or mismatched sizes.
+raster::Result<MultiviewStats>
+synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
+                    const raster::Frame& pinhole, const raster::LayeredTarget& layers,
+                    const LayerSpacing& spacing, const MultiviewSettings& settings,
+                    const ShadingInputs& shading, glm::vec3 background, raster::TaskPool& pool,
+                    MultiviewScratch& scratch, std::vector<float>& rgba);
+
+using PinholeFn = std::function<raster::Status(const raster::View&, raster::Frame&)>;
+using LayersFn = std::function<raster::Status(const raster::View&, const raster::LayeredTargetDesc&,
+                                              raster::LayeredTarget&)>;
+
+// The whole method: pinhole render (visible depth range, §4.1), layered render (§4.2), then
+// synthesizeMultiview. When nothing is visible the output is the pinhole frame. `rgba` as above.
+raster::Result<MultiviewStats>
+renderMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
+                const MultiviewSettings& settings, const ShadingInputs& shading,
+                glm::vec3 background, const PinholeFn& render_pinhole,
+                const LayersFn& render_layers, raster::TaskPool& pool, std::vector<float>& rgba,
+                raster::Frame* pinhole_out = nullptr, raster::LayeredTarget* layers_out = nullptr);
+
+// Validates settings alone (ranges of every option, messages naming them).
+raster::Status validate(const MultiviewSettings& settings, uint32_t sample_count);
+
+} // namespace dof

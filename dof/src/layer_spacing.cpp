@@ -1,0 +1,122 @@
+#include <dof/layer_spacing.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace dof {
+
+using raster::Status;
+
+namespace {
+
+// Margin so that the nearest and farthest visible depths fall strictly inside the bounds.
+constexpr float kRangeMargin = 1e-4f;
+
+LayerSpacing makeSpacing(const ThinLens& lens, const DepthRange& range, uint32_t layers,
+                         float delta_px) {
+    LayerSpacing s;
+    s.layers = layers;
+    s.delta_px = delta_px;
+    s.coc_near_px = cocRadiusPx(lens, range.near_d);
+    s.coc_far_px = cocRadiusPx(lens, range.far_d);
+    s.bounds.resize(layers + 1);
+    s.bounds[0] = range.near_d * (1.0f - kRangeMargin);
+    s.bounds[layers] = range.far_d * (1.0f + kRangeMargin);
+    // Bound l sits where C(d) = C(d_near) + l * delta (Eq. 4 inverted):
+    // 1/d = 1/d_f - C / (E f_px).
+    const double k = double(lens.aperture_radius) * double(lens.focal_length_px);
+    for (uint32_t l = 1; l < layers; ++l) {
+        const double c = double(s.coc_near_px) + double(l) * double(delta_px);
+        const double inv_d = 1.0 / double(lens.focus_distance) - c / k;
+        float d = inv_d > 0.0 ? float(1.0 / inv_d) : s.bounds[layers];
+        d = std::clamp(d, s.bounds[l - 1], s.bounds[layers]);
+        s.bounds[l] = d;
+    }
+    // Keep the bounds strictly increasing (raster::renderLayers requires it) even when float
+    // rounding collapses two neighbours.
+    for (uint32_t l = 1; l <= layers; ++l)
+        if (!(s.bounds[l] > s.bounds[l - 1]))
+            s.bounds[l] = std::nextafter(s.bounds[l - 1], INFINITY);
+    return s;
+}
+
+Status checkRange(const DepthRange& range) {
+    if (!range.covered)
+        return Status::error("multiview: nothing is visible, no depth range to decompose");
+    if (!(range.near_d > 0.0f) || !std::isfinite(range.far_d) || range.far_d < range.near_d)
+        return Status::error("multiview: invalid visible depth range");
+    return {};
+}
+
+} // namespace
+
+DepthRange visibleDepthRange(const raster::Frame& pinhole, const raster::View& view) {
+    // One pass in pixel order: min/max are order-independent, so this is deterministic.
+    DepthRange r;
+    float lo = INFINITY, hi = 0.0f;
+    const size_t pixels = size_t(pinhole.width) * pinhole.height;
+    for (size_t i = 0; i < pixels; ++i) {
+        const float stored = pinhole.depth.load(i);
+        if (!(stored < 1.0f))
+            continue;
+        const float d = raster::distanceFromDepth(view, stored);
+        if (!std::isfinite(d) || !(d > 0.0f))
+            continue;
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+    }
+    if (hi > 0.0f) {
+        r.near_d = lo;
+        r.far_d = hi;
+        r.covered = true;
+    }
+    return r;
+}
+
+raster::Result<LayerSpacing> layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range,
+                                                   float delta_px, uint32_t max_layers) {
+    if (!std::isfinite(delta_px) || !(delta_px > 0.0f))
+        return Status::error("--layer-spacing must be a positive number of pixels");
+    if (max_layers == 0)
+        return Status::error("--layers: the layer budget must be at least 1");
+    if (Status st = checkRange(range); !st.ok())
+        return st;
+    const double span =
+        double(cocRadiusPx(lens, range.far_d)) - double(cocRadiusPx(lens, range.near_d));
+    const double wanted = std::ceil(span / double(delta_px));
+    uint32_t m = uint32_t(std::clamp(wanted, 1.0, 1e6));
+    bool limited = false;
+    float delta = delta_px;
+    if (m > max_layers) {
+        m = max_layers;
+        delta = float(span / double(m));
+        limited = true;
+    }
+    LayerSpacing s = makeSpacing(lens, range, m, delta);
+    s.budget_limited = limited;
+    return s;
+}
+
+raster::Result<LayerSpacing> layerSpacingFromCount(const ThinLens& lens, const DepthRange& range,
+                                                   uint32_t layers) {
+    if (layers == 0)
+        return Status::error("--layers must be at least 1");
+    if (Status st = checkRange(range); !st.ok())
+        return st;
+    const double span =
+        double(cocRadiusPx(lens, range.far_d)) - double(cocRadiusPx(lens, range.near_d));
+    return makeSpacing(lens, range, layers, float(span / double(layers)));
+}
+
+uint32_t layerIndex(const ThinLens& lens, const LayerSpacing& spacing, float depth) {
+    if (spacing.layers <= 1 || !(spacing.delta_px > 0.0f))
+        return 0;
+    // Eq. 4 with K d_f (1/d_near - 1/d) = C(d) - C(d_near).
+    const double l = std::floor((double(cocRadiusPx(lens, depth)) - double(spacing.coc_near_px)) /
+                                double(spacing.delta_px));
+    return uint32_t(std::clamp(l, 0.0, double(spacing.layers - 1)));
+}
+
+} // namespace dof

@@ -1,0 +1,786 @@
+#include <dof/multiview.h>
+#include <raster/surface_shading.h>
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+
+namespace dof {
+
+using raster::Status;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Stored depth of an empty layer texel in the scratch copy: above every real D in [0,1].
+constexpr float kEmptyDepth = 2.0f;
+// Cone coverage at or above this ends the traversal (the cone is fully blocked, §4.4).
+constexpr float kFullCoverage = 0.999f;
+// Most mip levels built for cone tracing (a 256-pixel cone diameter).
+constexpr uint32_t kMaxMipLevels = 8;
+constexpr float kPi = 3.14159265358979f;
+
+// Per-layer constants of the traversal, in stored depth D (the ray is a straight line in
+// (x, y, D) because both the image offset C and D are affine in 1/d: Eq. 3 and camera.h).
+struct LayerSeg {
+    float t0 = 0.0f, t1 = 0.0f; // segment bounds in D (overlapped interval, §4.2)
+    float reach_px = 0.0f;      // farthest image offset of any ray in the segment
+    bool empty = true;
+};
+
+// One traced ray's result inside a layer.
+struct Hit {
+    bool hit = false;
+    float t = 0.0f;
+    uint32_t texel = 0;
+};
+
+struct TileCounters {
+    uint64_t rays = 0, discarded = 0, background = 0, layer_tests = 0, culled_pixel = 0,
+             culled_tile = 0, culled_ray = 0, cone_partial = 0, fetches = 0;
+};
+
+// Everything the per-pixel loop reads; built once per frame.
+struct Tracer {
+    const raster::View* view = nullptr;
+    const ThinLens* lens = nullptr;
+    const LensSampleSet* samples = nullptr;
+    const raster::LayeredTarget* layers = nullptr;
+    const MultiviewSettings* settings = nullptr;
+    const ShadingInputs* shading = nullptr;
+    const MultiviewScratch* scratch = nullptr;
+    const raster::Frame* pinhole = nullptr;
+    const raster::SurfaceShader* shader = nullptr; // view-dependent shading (§5)
+    std::vector<LayerSeg> segs;
+    uint32_t width = 0, height = 0;
+    float coc_a = 0.0f, coc_b = 0.0f; // C(D) = coc_a + coc_b * D
+    float lambda = 0.0f;
+    float r_max = 1.0f; // bound of |v| over every lens position a ray may use
+    glm::vec3 background{0.0f};
+
+    float cocOf(float t) const { return coc_a + coc_b * t; }
+};
+
+float distanceFromD(const raster::View& view, float d_stored) {
+    return raster::distanceFromDepth(view, d_stored);
+}
+
+// §4.3 "Ray Traversal": the lens ray's segment in layer `l` against the layer's height field,
+// by the method of false position followed by a binary search. The ray's image position at
+// depth t is p + C(t) * w (Eq. 2-3, lens.h), w = (-v.x, v.y).
+Hit traceLayer(const Tracer& tr, uint32_t l, float s0, float s1, float cx, float cy, glm::vec2 w,
+               TileCounters& cnt) {
+    const float* depth = tr.scratch->depth[l].data();
+    const uint32_t width = tr.width, height = tr.height;
+    const bool clamp = tr.settings->offscreen == OffscreenPolicy::Clamp;
+    const float seg_near = tr.segs[l].t0;
+    struct Sample {
+        float h; // stored D of the texel, or kEmptyDepth
+        uint32_t texel;
+        bool covered;
+    };
+    auto fetch = [&](float t) -> Sample {
+        ++cnt.fetches;
+        const float c = tr.cocOf(t);
+        float px = std::floor(cx + c * w.x), py = std::floor(cy + c * w.y);
+        if (clamp) {
+            px = std::clamp(px, 0.0f, float(width - 1));
+            py = std::clamp(py, 0.0f, float(height - 1));
+        } else if (px < 0.0f || py < 0.0f || px >= float(width) || py >= float(height)) {
+            return {kEmptyDepth, 0, false};
+        }
+        const uint32_t texel = uint32_t(py) * width + uint32_t(px);
+        const float h = depth[texel];
+        // Texels beyond the segment's far end count as empty, so N-buffer culling (min > far) is
+        // exactly lossless. Texels before the layer's near bound are the near parts of triangles
+        // routed here by their farthest vertex (§4.2); the fragment-copy pass put them in their
+        // own layer, so here they count as empty too.
+        return {h, texel, h <= s1 && h >= seg_near};
+    };
+    // Signed distance f = t - h along the ray: f < 0 while the ray is in front of the surface.
+    // Heights are bound by the layer's extents (§4.3). Empty texels (§4.3, Fig. 5 right) take the
+    // far bound inside the segment and at its near end (the ray passes in front), and the near
+    // bound at its far end, so the linear model always brackets an intersection in the layer.
+    auto fInterior = [&](float t, const Sample& s) {
+        return s.covered ? t - std::clamp(s.h, s0, s1) : t - s1;
+    };
+
+    Hit hit;
+    const Sample a = fetch(s0);
+    float ta = s0, fa = fInterior(s0, a);
+    if (a.covered && fa >= 0.0f) { // the surface is at or before the segment's start
+        hit.hit = true;
+        hit.t = s0;
+        hit.texel = a.texel;
+        return hit;
+    }
+    Sample b = fetch(s1);
+    float tb = s1, fb = b.covered ? s1 - std::clamp(b.h, s0, s1) : s1 - s0;
+    // Method of false position: intersect the ray with the line through (ta, fa), (tb, fb).
+    for (uint32_t k = 0; k < tr.settings->iterations; ++k) {
+        const float denom = fb - fa;
+        if (!(denom > 0.0f))
+            break;
+        const float ti = ta + (tb - ta) * (-fa / denom);
+        if (!(ti > ta && ti < tb))
+            break;
+        const Sample si = fetch(ti);
+        const float fi = fInterior(ti, si);
+        if (fi >= 0.0f) { // the surface is before I: the crossing lies in [ta, ti]
+            tb = ti, fb = fi, b = si;
+            break;
+        }
+        ta = ti, fa = fi; // restart with the farther sub-segment
+    }
+    // Binary search refinement of the bracket [ta, tb].
+    for (uint32_t k = 0; k < tr.settings->refine_steps; ++k) {
+        const float tm = 0.5f * (ta + tb);
+        if (!(tm > ta && tm < tb))
+            break;
+        const Sample sm = fetch(tm);
+        const float fm = fInterior(tm, sm);
+        if (fm >= 0.0f)
+            tb = tm, fb = fm, b = sm;
+        else
+            ta = tm, fa = fm;
+    }
+    if (b.covered) {
+        hit.hit = true;
+        hit.t = tb;
+        hit.texel = b.texel;
+    }
+    return hit;
+}
+
+// Trilinear lookup of the premultiplied coverage mipmap of layer l (§4.4) at image position
+// (px, py) for a window of `diameter` pixels.
+glm::vec4 sampleCone(const Tracer& tr, uint32_t l, float px, float py, float diameter) {
+    const MultiviewScratch& sc = *tr.scratch;
+    const uint32_t top = uint32_t(sc.mip_width.size()) - 1;
+    const float level = std::clamp(std::log2(std::max(diameter, 1.0f)), 0.0f, float(top));
+    const uint32_t l0 = uint32_t(level);
+    const uint32_t l1 = std::min(l0 + 1, top);
+    const float f = level - float(l0);
+    auto bilinear = [&](uint32_t lv) {
+        const std::vector<float>& img = sc.mips[l][lv];
+        const uint32_t w = sc.mip_width[lv], h = sc.mip_height[lv];
+        const float scale = 1.0f / float(1u << lv);
+        const float u = px * scale - 0.5f, v = py * scale - 0.5f;
+        const float fu = std::floor(u), fv = std::floor(v);
+        const float au = u - fu, av = v - fv;
+        auto at = [&](float x, float y) {
+            const uint32_t xi = uint32_t(std::clamp(x, 0.0f, float(w - 1)));
+            const uint32_t yi = uint32_t(std::clamp(y, 0.0f, float(h - 1)));
+            const float* p = img.data() + (size_t(yi) * w + xi) * 4;
+            return glm::vec4(p[0], p[1], p[2], p[3]);
+        };
+        const glm::vec4 top_row = at(fu, fv) * (1.0f - au) + at(fu + 1.0f, fv) * au;
+        const glm::vec4 bottom = at(fu, fv + 1.0f) * (1.0f - au) + at(fu + 1.0f, fv + 1.0f) * au;
+        return top_row * (1.0f - av) + bottom * av;
+    };
+    const glm::vec4 c0 = bilinear(l0);
+    if (l1 == l0 || f == 0.0f)
+        return c0;
+    return c0 * (1.0f - f) + bilinear(l1) * f;
+}
+
+glm::vec3 envLookup(const EnvironmentMap& env, glm::vec3 dir) {
+    const float u = 0.5f + std::atan2(dir.x, -dir.z) / (2.0f * kPi);
+    const float v = std::acos(std::clamp(dir.y, -1.0f, 1.0f)) / kPi;
+    const uint32_t x = std::min(uint32_t(std::max(u, 0.0f) * float(env.width)), env.width - 1);
+    const uint32_t y = std::min(uint32_t(std::max(v, 0.0f) * float(env.height)), env.height - 1);
+    const float* p = env.rgb.data() + (size_t(y) * env.width + x) * 3;
+    return glm::vec3(p[0], p[1], p[2]) * env.intensity;
+}
+
+// §5: shade the G-buffer sample of a hit from lens point `eye`: the rasterizer's Phong model
+// (raster::shadeSurface) plus, with an environment map, a Schlick-Fresnel mirror reflection
+// attenuated by roughness.
+glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::vec3 eye) {
+    const raster::LayeredTarget& lt = *tr.layers;
+    const raster::GSample& g = lt.gbuffer[lt.index(l, texel)];
+    const raster::View& view = *tr.view;
+    // World position of the texel centre at its stored depth (pinhole through the lens centre).
+    const float d = distanceFromD(view, t);
+    const uint32_t ix = texel % tr.width, iy = texel / tr.width;
+    const float f_px = tr.lens->focal_length_px;
+    const float sx = (float(ix) + 0.5f - 0.5f * float(tr.width)) / f_px;
+    const float sy = (float(iy) + 0.5f - 0.5f * float(tr.height)) / f_px;
+    const glm::vec3 world = view.eye + d * (view.forward + sx * view.right - sy * view.up);
+    glm::vec3 c = tr.shader->shade(g, world, eye);
+    const EnvironmentMap* env = tr.settings->env_map;
+    if (env && g.unlit == 0.0f) {
+        const glm::vec3 vdir = glm::normalize(eye - world);
+        const float n_dot_v = std::max(glm::dot(g.normal, vdir), 0.0f);
+        const glm::vec3 r = glm::reflect(-vdir, g.normal);
+        const glm::vec3 f0 = glm::mix(glm::vec3(0.04f), g.base_color, g.metallic);
+        const float m = 1.0f - n_dot_v;
+        const glm::vec3 fresnel = f0 + (glm::vec3(1.0f) - f0) * (m * m * m * m * m);
+        const float gloss = (1.0f - g.roughness) * (1.0f - g.roughness);
+        c += fresnel * gloss * envLookup(*env, r);
+    }
+    return c;
+}
+
+// The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
+LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
+                          const std::array<float, 4>& noise, uint32_t halton_offset) {
+    const MultiviewSettings& s = *tr.settings;
+    switch (s.jitter) {
+    case JitterMode::None:
+        return tr.samples->sample(k);
+    case JitterMode::Rotate:
+        return tr.samples->sample(x, y, k);
+    case JitterMode::Halton: {
+        const LensSampleSet& seq = *s.sequence_2n;
+        return seq.sample((halton_offset + k) % seq.size());
+    }
+    case JitterMode::Noise: {
+        // 16 pairwise combinations (n_i, n_j) of the texel's four components, each applied to
+        // 1/16th of the samples, scaled to half the mean sample spacing (§4.5).
+        LensSample ls = tr.samples->sample(k);
+        const uint32_t combo = k % 16;
+        const glm::vec2 off(noise[combo / 4], noise[combo % 4]);
+        glm::vec2 p = ls.position + tr.lambda * off;
+        const float len = glm::length(p);
+        if (len > tr.r_max)
+            p *= tr.r_max / len; // stay within the aperture's radius
+        ls.position = p;
+        return ls;
+    }
+    }
+    return tr.samples->sample(k);
+}
+
+// Square window (texel range) any ray of a pixel region can read in layer l, clamped to the
+// image, as an N-buffer query. Returns true when the layer can be skipped (§4.3 early culling:
+// the minimum depth in the window is beyond the layer's far bound).
+bool culled(const Tracer& tr, uint32_t l, float x_lo, float x_hi, float y_lo, float y_hi) {
+    const LayerSeg& seg = tr.segs[l];
+    const float r = seg.reach_px;
+    auto clampi = [](float v, int64_t hi) {
+        return std::clamp<int64_t>(int64_t(std::floor(v)), 0, hi);
+    };
+    const int64_t x0 = clampi(x_lo - r, tr.width - 1), x1 = clampi(x_hi + r, tr.width - 1);
+    const int64_t y0 = clampi(y_lo - r, tr.height - 1), y1 = clampi(y_hi + r, tr.height - 1);
+    const int64_t size = std::max(x1 - x0, y1 - y0) + 1;
+    return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > seg.t1;
+}
+
+// Whether layer l has no texel within its segment in the image box [x_lo, x_hi] x [y_lo, y_hi]
+// (positions, clamped to the image as OffscreenPolicy::Clamp reads them).
+bool boxCulled(const Tracer& tr, uint32_t l, float x_lo, float x_hi, float y_lo, float y_hi) {
+    auto clampi = [](float v, int64_t hi) {
+        return std::clamp<int64_t>(int64_t(std::floor(v)), 0, hi);
+    };
+    const int64_t x0 = clampi(x_lo, tr.width - 1), x1 = clampi(x_hi, tr.width - 1);
+    const int64_t y0 = clampi(y_lo, tr.height - 1), y1 = clampi(y_hi, tr.height - 1);
+    const int64_t size = std::max(x1 - x0, y1 - y0) + 1;
+    return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > tr.segs[l].t1;
+}
+
+void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_layers,
+                uint32_t tile_layer_count, float* out, TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    // Layers this pixel's rays can hit (early culling per pixel, §4.3).
+    std::array<uint32_t, raster::kMaxLayers> active{};
+    uint32_t active_count = 0;
+    for (uint32_t i = 0; i < tile_layer_count; ++i) {
+        const uint32_t l = tile_layers[i];
+        if (s.culling && culled(tr, l, cx, cx, cy, cy)) {
+            ++cnt.culled_pixel;
+            continue;
+        }
+        active[active_count++] = l;
+    }
+    // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
+    std::array<float, 4> noise{};
+    uint32_t halton_offset = 0;
+    if (s.jitter == JitterMode::Noise)
+        for (uint32_t c = 0; c < 4; ++c)
+            noise[c] = hashToUnit(hashWords(x, y, s.seed, 0x6e6f6973u + c)) - 0.5f;
+    if (s.jitter == JitterMode::Halton)
+        halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
+
+    const raster::View& view = *tr.view;
+    const raster::LayeredTarget& lt = *tr.layers;
+    const bool shade = s.view_dependent || s.env_map;
+    const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
+    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
+    const uint32_t n = tr.samples->size();
+    for (uint32_t k = 0; k < n; ++k) {
+        ++cnt.rays;
+        const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
+        const glm::vec2 w(-ls.position.x, ls.position.y); // lensRayImageOffset per unit C
+        auto inside = [&](float t) {
+            const float c = tr.cocOf(t);
+            const float px = cx + c * w.x, py = cy + c * w.y;
+            return px >= 0.0f && py >= 0.0f && px < float(tr.width) && py < float(tr.height);
+        };
+        const bool discard = s.offscreen == OffscreenPolicy::Discard;
+        if (discard && !inside(t_first)) { // the path starts outside the image
+            ++cnt.discarded;
+            continue;
+        }
+        const glm::vec3 lens_point =
+            view.eye +
+            tr.lens->aperture_radius * (ls.position.x * view.right + ls.position.y * view.up);
+        glm::vec3 color(0.0f);
+        float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4)
+        float t_resume = -1.0f;
+        float t_end = t_last;
+        for (uint32_t i = 0; i < active_count && transmit > 0.0f; ++i) {
+            const uint32_t l = active[i];
+            const LayerSeg& seg = tr.segs[l];
+            const float s0 = std::max(seg.t0, t_resume);
+            if (!(s0 < seg.t1))
+                continue;
+            if (s.culling) {
+                // Per-ray culling: the texels this ray's segment can read lie in the box of its
+                // end points; one N-buffer query skips the height-field test when none of them
+                // is within the layer (the same test as §4.3's per-pixel culling, on a smaller
+                // window, so it is just as lossless).
+                const float c0 = tr.cocOf(s0), c1e = tr.cocOf(seg.t1);
+                const float xa = cx + c0 * w.x, xb = cx + c1e * w.x;
+                const float ya = cy + c0 * w.y, yb = cy + c1e * w.y;
+                if (boxCulled(tr, l, std::min(xa, xb), std::max(xa, xb), std::min(ya, yb),
+                              std::max(ya, yb))) {
+                    ++cnt.culled_ray;
+                    continue;
+                }
+            }
+            ++cnt.layer_tests;
+            const Hit h = traceLayer(tr, l, s0, seg.t1, cx, cy, w, cnt);
+            if (!h.hit)
+                continue;
+            const float c_hit = tr.cocOf(h.t);
+            glm::vec3 c1;
+            float v1 = 1.0f;
+            if (s.cone && tr.lambda * std::fabs(c_hit) > 1.0f) {
+                // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha
+                // is its coverage v1, the mipmapped RGB / v1 its mean colour c1.
+                const glm::vec4 m = sampleCone(tr, l, cx + c_hit * w.x, cy + c_hit * w.y,
+                                               tr.lambda * std::fabs(c_hit));
+                v1 = std::clamp(m.a, 0.0f, 1.0f);
+                c1 = v1 > 0.0f ? glm::vec3(m) / m.a : glm::vec3(0.0f);
+            } else {
+                c1 = glm::vec3(lt.color.load(lt.index(l, h.texel)));
+            }
+            if (shade)
+                c1 = shadeHit(tr, l, h.texel, h.t, s.view_dependent ? lens_point : view.eye);
+            if (v1 >= kFullCoverage) {
+                color += transmit * c1;
+                transmit = 0.0f;
+                t_end = h.t;
+                break;
+            }
+            // v1 c1 + (1 - v1) c2: continue along the centre ray for c2.
+            ++cnt.cone_partial;
+            color += transmit * v1 * c1;
+            transmit *= 1.0f - v1;
+            t_resume = h.t + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
+            t_end = h.t;
+        }
+        if (transmit > 0.0f) {
+            ++cnt.background;
+            color += transmit * tr.background;
+            t_end = t_last;
+        }
+        if (discard && !inside(t_end)) { // the path to the hit leaves the image
+            ++cnt.discarded;
+            continue;
+        }
+        const double wt = double(ls.weight);
+        sum_r += wt * double(color.r);
+        sum_g += wt * double(color.g);
+        sum_b += wt * double(color.b);
+        sum_w += wt;
+    }
+    if (sum_w > 0.0) {
+        out[0] = float(sum_r / sum_w);
+        out[1] = float(sum_g / sum_w);
+        out[2] = float(sum_b / sum_w);
+    } else { // every ray left the image: the pinhole colour
+        const size_t i = (size_t(y) * tr.width + x) * 4;
+        out[0] = tr.pinhole->color[i];
+        out[1] = tr.pinhole->color[i + 1];
+        out[2] = tr.pinhole->color[i + 2];
+    }
+    out[3] = 1.0f;
+}
+
+} // namespace
+
+Status validate(const MultiviewSettings& s, uint32_t sample_count) {
+    if (sample_count == 0)
+        return Status::error("--samples must be at least 1");
+    if (s.layers == 0 && (!std::isfinite(s.layer_spacing_px) || !(s.layer_spacing_px > 0.0f)))
+        return Status::error("--layer-spacing must be a positive number of pixels");
+    if (s.layers > raster::kMaxLayers)
+        return Status::error("--layers must be at most " + std::to_string(raster::kMaxLayers));
+    if (!std::isfinite(s.overlap) || s.overlap < 0.0f || s.overlap > 1.0f)
+        return Status::error("--overlap must be in [0, 1]");
+    if (s.iterations > 64)
+        return Status::error("--iterations must be at most 64");
+    if (s.refine_steps > 32)
+        return Status::error("--refine-steps must be at most 32");
+    if (s.tile_size == 0 || s.tile_size > 1024)
+        return Status::error("multiview: tile size must be in [1, 1024]");
+    if (s.jitter == JitterMode::Halton) {
+        if (!s.sequence_2n || s.sequence_2n->size() == 0)
+            return Status::error("--jitter halton needs a 2N-sample sequence");
+        if (s.sequence_2n->size() < sample_count)
+            return Status::error("--jitter halton: the sequence must hold at least --samples");
+    }
+    if (s.env_map) {
+        const EnvironmentMap& e = *s.env_map;
+        if (e.width == 0 || e.height == 0 || e.rgb.size() != size_t(e.width) * e.height * 3)
+            return Status::error("--env-map: the image is empty or its size does not match");
+        if (!std::isfinite(e.intensity) || e.intensity < 0.0f)
+            return Status::error("--env-intensity must be a non-negative number");
+    }
+    return {};
+}
+
+float meanNeighbourDistance(const LensSampleSet& samples) {
+    const uint32_t n = samples.size();
+    if (n < 2)
+        return 0.0f;
+    double sum = 0.0;
+    for (uint32_t i = 0; i < n; ++i) {
+        float best = INFINITY;
+        for (uint32_t j = 0; j < n; ++j)
+            if (j != i)
+                best = std::min(
+                    best, glm::length(samples.sample(i).position - samples.sample(j).position));
+        sum += double(best);
+    }
+    return float(sum / double(n));
+}
+
+raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& lens,
+                                                             const DepthRange& range,
+                                                             const MultiviewSettings& settings,
+                                                             LayerSpacing* spacing_out) {
+    raster::Result<LayerSpacing> sp =
+        settings.layers > 0
+            ? layerSpacingFromCount(lens, range, settings.layers)
+            : layerSpacingFromDelta(lens, range, settings.layer_spacing_px, raster::kMaxLayers);
+    if (!sp.ok())
+        return sp.status();
+    raster::LayeredTargetDesc desc;
+    desc.bounds = sp->bounds;
+    desc.overlap = settings.overlap;
+    desc.routing = settings.routing;
+    desc.color_format = settings.color_format;
+    desc.depth_format = settings.depth_format;
+    desc.gbuffer = settings.view_dependent || settings.env_map != nullptr;
+    if (spacing_out)
+        *spacing_out = std::move(*sp);
+    return desc;
+}
+
+raster::Result<MultiviewStats>
+synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
+                    const raster::Frame& pinhole, const raster::LayeredTarget& layers,
+                    const LayerSpacing& spacing, const MultiviewSettings& settings,
+                    const ShadingInputs& shading, glm::vec3 background, raster::TaskPool& pool,
+                    MultiviewScratch& scratch, std::vector<float>& rgba) {
+    if (Status st = validate(settings, samples.size()); !st.ok())
+        return st;
+    if (Status st = validate(lens, view); !st.ok())
+        return st;
+    const uint32_t width = view.width, height = view.height;
+    if (pinhole.width != width || pinhole.height != height || layers.width != width ||
+        layers.height != height)
+        return Status::error("multiview: the pinhole frame and layers must match the view size");
+    if (layers.layer_count == 0 || layers.layer_count > raster::kMaxLayers)
+        return Status::error("multiview: the layered target has no layers");
+    const bool shade = settings.view_dependent || settings.env_map;
+    if (shade &&
+        (layers.gbuffer.size() != layers.pixelCount() * layers.layer_count || !shading.scene))
+        return Status::error("--view-dependent needs layers rendered with a G-buffer");
+
+    MultiviewStats stats;
+    const uint32_t m = layers.layer_count;
+    stats.layers = m;
+    stats.delta_px = spacing.delta_px;
+    stats.budget_limited = spacing.budget_limited;
+    stats.layered_bytes = layers.bytes();
+
+    Tracer tr;
+    tr.view = &view;
+    tr.lens = &lens;
+    tr.samples = &samples;
+    tr.layers = &layers;
+    tr.settings = &settings;
+    tr.shading = &shading;
+    tr.scratch = &scratch;
+    tr.pinhole = &pinhole;
+    tr.width = width;
+    tr.height = height;
+    tr.background = background;
+    std::optional<raster::SurfaceShader> shader;
+    if (shade) {
+        shader.emplace(*shading.scene, view);
+        tr.shader = &*shader;
+    }
+    // C as an affine function of stored depth D: 1/d = 1/n - D (1/n - 1/f) (camera.h), so
+    // C = E f_px (1/d_f - 1/n) + E f_px (1/n - 1/f) D (Eq. 3).
+    {
+        const double ef = double(lens.aperture_radius) * double(lens.focal_length_px);
+        const double inv_n = 1.0 / double(view.znear);
+        const double inv_f = view.zfar > 0.0f ? 1.0 / double(view.zfar) : 0.0;
+        tr.coc_a = float(ef * (1.0 / double(lens.focus_distance) - inv_n));
+        tr.coc_b = float(ef * (inv_n - inv_f));
+    }
+    tr.lambda = meanNeighbourDistance(samples);
+    stats.lambda = tr.lambda;
+    float r_max = 0.0f;
+    for (const LensSample& ls : samples.samples())
+        r_max = std::max(r_max, glm::length(ls.position));
+    if (settings.jitter == JitterMode::Halton)
+        for (const LensSample& ls : settings.sequence_2n->samples())
+            r_max = std::max(r_max, glm::length(ls.position));
+    if (settings.jitter == JitterMode::Rotate)
+        r_max = std::max(r_max, std::sqrt(2.0f)); // any aperture lies in [-1,1]^2
+    tr.r_max = std::max(r_max, 1e-6f);
+
+    // Per-layer float depths (empty -> kEmptyDepth), content extents, N-buffers and coverage
+    // mipmaps; one task per layer, each writing only its own slots.
+    auto t0 = Clock::now();
+    const size_t pixels = size_t(width) * height;
+    scratch.depth.resize(m);
+    scratch.nbuffers.assign(m, NBuffer{});
+    std::vector<float> content_min(m, INFINITY), content_max(m, -INFINITY);
+    pool.parallelFor(m, [&](uint32_t l, uint32_t) {
+        std::vector<float>& d = scratch.depth[l];
+        d.resize(pixels);
+        float lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < pixels; ++i) {
+            const size_t li = layers.index(l, i);
+            const bool covered = layers.color.load(li).a > 0.0f;
+            const float v = covered ? layers.depth.load(li) : kEmptyDepth;
+            d[i] = v;
+            if (covered) {
+                lo = std::min(lo, v);
+                hi = std::max(hi, v);
+            }
+        }
+        content_min[l] = lo;
+        content_max[l] = hi;
+    });
+    // Segments: the overlapped interval of each layer in D (§4.2); the first and last layers
+    // also reach their content (depths outside the bounds are routed there).
+    tr.segs.resize(m);
+    float reach_max = 0.0f;
+    for (uint32_t l = 0; l < m; ++l) {
+        LayerSeg& seg = tr.segs[l];
+        const raster::LayerInterval iv = raster::overlappedInterval(layers.desc, l);
+        const float near_d = l == 0 ? layers.desc.bounds[0] : iv.near_d;
+        const float far_d = l + 1 == m ? layers.desc.bounds[m] : iv.far_d;
+        seg.t0 = raster::depthFromDistance(view, near_d);
+        seg.t1 = raster::depthFromDistance(view, far_d);
+        if (content_max[l] >= content_min[l]) {
+            seg.empty = false;
+            if (l == 0)
+                seg.t0 = std::min(seg.t0, content_min[l]);
+            if (l + 1 == m)
+                seg.t1 = std::max(seg.t1, content_max[l]);
+        }
+        seg.t0 = std::clamp(seg.t0, 0.0f, 1.0f);
+        seg.t1 = std::clamp(seg.t1, seg.t0, 1.0f);
+        // Every ray of a pixel stays within r_max * max |C| of it over the segment (C is
+        // monotonic in D, so the extreme is at an end).
+        seg.reach_px =
+            tr.r_max * std::max(std::fabs(tr.cocOf(seg.t0)), std::fabs(tr.cocOf(seg.t1)));
+        if (!seg.empty)
+            reach_max = std::max(reach_max, seg.reach_px);
+        else
+            ++stats.layers_empty;
+    }
+    stats.ms_decomposition = msSince(t0); // the copy belongs to the decomposition's cost
+
+    t0 = Clock::now();
+    if (settings.culling) {
+        pool.parallelFor(m, [&](uint32_t l, uint32_t) {
+            if (tr.segs[l].empty)
+                return;
+            // Window side 2 * reach + 2 texels for a pixel; the tile query uses more (it falls
+            // back to a conservative tiling when the levels run out).
+            const float side = 2.0f * tr.segs[l].reach_px + 2.0f + float(settings.tile_size);
+            uint32_t level = 0;
+            while (level < 16 && float(2u << level) <= side)
+                ++level;
+            buildNBuffer(scratch.depth[l].data(), width, height, level, scratch.nbuffers[l]);
+        });
+        for (uint32_t l = 0; l < m; ++l)
+            stats.nbuffer_levels = std::max(stats.nbuffer_levels, scratch.nbuffers[l].levelCount());
+    }
+    stats.ms_nbuffer = msSince(t0);
+
+    t0 = Clock::now();
+    scratch.mips.assign(m, {});
+    scratch.mip_width.clear();
+    scratch.mip_height.clear();
+    if (settings.cone) {
+        // §4.4: mipmaps of the layer colour with coverage alpha (premultiplied: empty texels
+        // are (0,0,0,0)), up to the level the widest cone needs.
+        // reach_max = r_max * the largest |C| of any non-empty segment.
+        const float widest = tr.lambda * reach_max / tr.r_max;
+        uint32_t levels = 1;
+        while (levels < kMaxMipLevels && float(1u << (levels - 1)) < widest)
+            ++levels;
+        scratch.mip_width.push_back(width);
+        scratch.mip_height.push_back(height);
+        for (uint32_t lv = 1; lv < levels; ++lv) {
+            scratch.mip_width.push_back(std::max(1u, (scratch.mip_width.back() + 1) / 2));
+            scratch.mip_height.push_back(std::max(1u, (scratch.mip_height.back() + 1) / 2));
+        }
+        stats.mip_levels = levels;
+        pool.parallelFor(m, [&](uint32_t l, uint32_t) {
+            if (tr.segs[l].empty)
+                return;
+            std::vector<std::vector<float>>& mip = scratch.mips[l];
+            mip.resize(levels);
+            mip[0].resize(pixels * 4);
+            for (size_t i = 0; i < pixels; ++i) {
+                const glm::vec4 c = layers.color.load(layers.index(l, i));
+                const float a = c.a > 0.0f ? 1.0f : 0.0f;
+                mip[0][i * 4] = c.r * a, mip[0][i * 4 + 1] = c.g * a, mip[0][i * 4 + 2] = c.b * a;
+                mip[0][i * 4 + 3] = a;
+            }
+            for (uint32_t lv = 1; lv < levels; ++lv) {
+                const uint32_t pw = scratch.mip_width[lv - 1], ph = scratch.mip_height[lv - 1];
+                const uint32_t cw = scratch.mip_width[lv], ch = scratch.mip_height[lv];
+                const std::vector<float>& src = mip[lv - 1];
+                std::vector<float>& dst = mip[lv];
+                dst.resize(size_t(cw) * ch * 4);
+                for (uint32_t y = 0; y < ch; ++y)
+                    for (uint32_t x = 0; x < cw; ++x) {
+                        const uint32_t x0 = std::min(2 * x, pw - 1),
+                                       x1 = std::min(2 * x + 1, pw - 1);
+                        const uint32_t y0 = std::min(2 * y, ph - 1),
+                                       y1 = std::min(2 * y + 1, ph - 1);
+                        for (uint32_t c = 0; c < 4; ++c)
+                            dst[(size_t(y) * cw + x) * 4 + c] =
+                                0.25f * (src[(size_t(y0) * pw + x0) * 4 + c] +
+                                         src[(size_t(y0) * pw + x1) * 4 + c] +
+                                         src[(size_t(y1) * pw + x0) * 4 + c] +
+                                         src[(size_t(y1) * pw + x1) * 4 + c]);
+                    }
+            }
+        });
+    }
+    stats.ms_mipmaps = msSince(t0);
+    for (uint32_t l = 0; l < m; ++l) {
+        for (const std::vector<float>& lv : scratch.nbuffers[l].levels)
+            stats.scratch_bytes += lv.size() * sizeof(float);
+        for (const std::vector<float>& lv : scratch.mips[l])
+            stats.scratch_bytes += lv.size() * sizeof(float);
+        stats.scratch_bytes += scratch.depth[l].size() * sizeof(float);
+    }
+
+    // §4.3: trace every pixel's lens rays, one task per output tile.
+    t0 = Clock::now();
+    rgba.assign(pixels * 4, 0.0f);
+    const uint32_t ts = settings.tile_size;
+    const uint32_t tiles_x = (width + ts - 1) / ts, tiles_y = (height + ts - 1) / ts;
+    std::vector<TileCounters> counters(size_t(tiles_x) * tiles_y);
+    pool.parallelFor(tiles_x * tiles_y, [&](uint32_t tile, uint32_t) {
+        TileCounters& cnt = counters[tile];
+        const uint32_t x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
+        const uint32_t x1 = std::min(x0 + ts, width), y1 = std::min(y0 + ts, height);
+        // Skip empty layers, and layers with nothing in reach of the whole tile (one query).
+        std::array<uint32_t, raster::kMaxLayers> tile_layers{};
+        uint32_t count = 0;
+        for (uint32_t l = 0; l < m; ++l) {
+            if (tr.segs[l].empty)
+                continue;
+            if (settings.culling && culled(tr, l, float(x0) + 0.5f, float(x1) - 0.5f,
+                                           float(y0) + 0.5f, float(y1) - 0.5f)) {
+                ++cnt.culled_tile;
+                continue;
+            }
+            tile_layers[count++] = l;
+        }
+        for (uint32_t y = y0; y < y1; ++y)
+            for (uint32_t x = x0; x < x1; ++x)
+                tracePixel(tr, x, y, tile_layers.data(), count,
+                           rgba.data() + (size_t(y) * width + x) * 4, cnt);
+    });
+    for (const TileCounters& c : counters) {
+        stats.rays += c.rays;
+        stats.rays_discarded += c.discarded;
+        stats.rays_background += c.background;
+        stats.layer_tests += c.layer_tests;
+        stats.layer_culled_pixel += c.culled_pixel;
+        stats.layer_culled_tile += c.culled_tile;
+        stats.layer_culled_ray += c.culled_ray;
+        stats.cone_partial += c.cone_partial;
+        stats.texel_fetches += c.fetches;
+    }
+    stats.ms_tracing = msSince(t0);
+    return stats;
+}
+
+raster::Result<MultiviewStats>
+renderMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
+                const MultiviewSettings& settings, const ShadingInputs& shading,
+                glm::vec3 background, const PinholeFn& render_pinhole,
+                const LayersFn& render_layers, raster::TaskPool& pool, std::vector<float>& rgba,
+                raster::Frame* pinhole_out, raster::LayeredTarget* layers_out) {
+    if (Status st = validate(settings, samples.size()); !st.ok())
+        return st;
+    if (Status st = validate(lens, view); !st.ok())
+        return st;
+    raster::Frame local_pinhole;
+    raster::Frame& pinhole = pinhole_out ? *pinhole_out : local_pinhole;
+    // §4.1: the pinhole through the lens centre gives the visible depth range.
+    auto t0 = Clock::now();
+    if (Status st = render_pinhole(view, pinhole); !st.ok())
+        return st;
+    const double ms_pinhole = msSince(t0);
+    const DepthRange range = visibleDepthRange(pinhole, view);
+    if (!range.covered) { // nothing to blur: the image is the background
+        rgba = pinhole.color;
+        MultiviewStats stats;
+        stats.ms_pinhole = ms_pinhole;
+        return stats;
+    }
+    LayerSpacing spacing;
+    raster::Result<raster::LayeredTargetDesc> desc =
+        multiviewLayerDesc(lens, range, settings, &spacing);
+    if (!desc.ok())
+        return desc.status();
+    raster::LayeredTarget local_layers;
+    raster::LayeredTarget& layers = layers_out ? *layers_out : local_layers;
+    t0 = Clock::now();
+    if (Status st = render_layers(view, *desc, layers); !st.ok())
+        return st;
+    const double ms_layers = msSince(t0);
+    MultiviewScratch scratch;
+    raster::Result<MultiviewStats> r =
+        synthesizeMultiview(view, lens, samples, pinhole, layers, spacing, settings, shading,
+                            background, pool, scratch, rgba);
+    if (!r.ok())
+        return r;
+    r->ms_pinhole = ms_pinhole;
+    r->ms_decomposition += ms_layers;
+    r->d_near = range.near_d;
+    r->d_far = range.far_d;
+    return r;
+}
+
+} // namespace dof
