@@ -39,6 +39,9 @@ struct MethodInput {
     // depth).
     std::optional<raster::ColorFormat> target_color;
     std::optional<raster::DepthFormat> target_depth;
+    // The aperture the lens samples were drawn on (--aperture-shape ...), for methods that draw
+    // their own per-pixel sample sets (e.g. multiview's 2N Halton jitter).
+    const dof::ApertureShape* aperture = nullptr;
 };
 
 // What it returns for one run.

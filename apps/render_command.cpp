@@ -3,9 +3,11 @@
 #include "apps/dof_method.h"
 #include "apps/image_io.h"
 #include "apps/scene_source.h"
+#include "apps/target_dumps.h"
 #include "apps/text_file.h"
 
 #include <dof/accum.h>
+#include <dof/layer_spacing.h>
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
 #include <raster/camera.h>
@@ -19,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <thread>
 #include <unistd.h>
@@ -227,7 +230,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     CLI::App* cmd = app.add_subcommand("render", "Render a scene to an image");
     args.threads = std::max(1u, std::thread::hardware_concurrency());
     cmd->add_option("scene", args.scene, "glTF file (.gltf/.glb) or builtin:NAME")->required();
-    cmd->add_option("-o,--output", args.output,
+    cmd->add_option("-o,--output", args.outputs,
                     "output image: .exr (linear float RGBA) or .png "
                     "(8-bit sRGB)")
         ->required();
@@ -252,7 +255,13 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
         ->check(CLI::Range(0, 256));
     cmd->add_option("--tile", args.tile, "tile size in pixels (multiple of 8, 8 to 256)")
         ->capture_default_str()
-        ->check(CLI::Range(8, 256));
+        ->check(CLI::Range(8, 256))
+        ->check(CLI::Validator(
+            [](const std::string& text) {
+                const int v = std::atoi(text.c_str());
+                return v % 8 == 0 ? std::string() : text + " is not a multiple of 8";
+            },
+            "MULTIPLE OF 8"));
     cmd->add_option("--method", args.method, "depth-of-field method")
         ->capture_default_str()
         ->check(CLI::IsMember(methodNames()));
@@ -323,6 +332,21 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
                     "rotation and, for poisson, other candidates)")
         ->capture_default_str();
     cmd->add_flag("--no-progress", args.no_progress, "accum: no progress bar on stderr");
+    cmd->add_flag("--no-simd", args.no_simd,
+                  "run the scalar reference kernels instead of the SIMD ones (same bits)");
+    cmd->add_option("--dump-layers", args.dump_layers,
+                    "write a layered decomposition (colour, depth per layer) into this folder");
+    cmd->add_option("--dump-layer-count", args.dump_layer_count,
+                    "layers for --dump-layers, uniform in 1/d over the visible depths")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
+    cmd->add_option("--dump-fragments", args.dump_fragments,
+                    "write per-pixel fragment-list counts and the first K fragment layers into "
+                    "this folder");
+    cmd->add_option("--dump-fragment-layers", args.dump_fragment_layers,
+                    "K for --dump-fragments")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 64));
     cmd->add_option("--precision", args.precision,
                     "layered targets / fragment lists: 16 (half colour, unorm16 depth) or 32 "
                     "(float) [default: the method's]")
@@ -401,6 +425,7 @@ int runRender(const RenderArgs& args) {
                              : args.texture_filter == "trilinear"
                                  ? raster::FilterOverride::Trilinear
                                  : raster::FilterOverride::Sampler;
+    options.simd = !args.no_simd;
 
     raster::TaskPool pool(args.threads);
     raster::Renderer renderer(pool);
@@ -522,7 +547,7 @@ int runRender(const RenderArgs& args) {
             accum_stats = *r;
         } else if (table_method) {
             MethodInput in{*scene, *view,   choice.lens,  *lens_samples,
-                           pool,   options, target_color, target_depth};
+                           pool,   options, target_color, target_depth, &*aperture_shape};
             method_out = MethodOutput{};
             if (Status s = table_method->run(in, method_out); !s.ok())
                 return fail(s.message());
@@ -567,8 +592,9 @@ int runRender(const RenderArgs& args) {
                      accum_stats.skip_reason.c_str());
 
     ImageData color{frame.width, frame.height, 4, frame.color};
-    if (Status s = writeImage(args.output, color); !s.ok())
-        return fail(s.message());
+    for (const std::string& output : args.outputs)
+        if (Status s = writeImage(output, color); !s.ok())
+            return fail(s.message());
     if (!args.depth_out.empty()) {
         // The pinhole depth: pinhole and accum leave it in the frame; a table method returns
         // its own, or gets a pinhole render here.
@@ -594,11 +620,67 @@ int runRender(const RenderArgs& args) {
         if (Status s = writeImage(args.depth_out, depth); !s.ok())
             return fail(s.message());
     }
+    // Look inside the GPU-emulating targets (docs/targets.md): layers over the visible depth
+    // range, uniform in 1/d, with the paper's routing; fragment lists with the closest K kept.
+    nlohmann::json target_stats;
+    if (!args.dump_layers.empty() || !args.dump_fragments.empty()) {
+        raster::Frame pinhole;
+        if (Status s = renderer.render(*scene, *view, options, pinhole); !s.ok())
+            return fail(s.message());
+        if (!args.dump_layers.empty()) {
+            const dof::DepthRange range = dof::visibleDepthRange(pinhole, *view);
+            if (!range.covered)
+                return fail(args.scene + ": nothing visible to decompose into layers");
+            raster::LayeredTargetDesc desc;
+            desc.bounds = uniformInverseDepthBounds(range.near_d, std::max(range.far_d,
+                                                    range.near_d * 1.001f),
+                                                    args.dump_layer_count);
+            desc.color_format = target_color.value_or(raster::ColorFormat::Float32);
+            desc.depth_format = target_depth.value_or(raster::DepthFormat::Float32);
+            raster::LayeredTarget layers;
+            raster::FrameStats ts;
+            if (Status s = renderer.renderLayers(*scene, *view, options, desc, layers, &ts);
+                !s.ok())
+                return fail(s.message());
+            if (Status s = dumpLayers(layers, *view, args.dump_layers); !s.ok())
+                return fail(s.message());
+            target_stats["layers"] = {{"count", layers.layer_count},
+                                      {"bounds", desc.bounds},
+                                      {"bytes", ts.target_bytes},
+                                      {"time_ms", {{"raster", ts.ms_raster},
+                                                   {"copy", ts.ms_resolve}}}};
+        }
+        if (!args.dump_fragments.empty()) {
+            raster::FragmentListDesc desc;
+            desc.max_per_pixel = std::max(desc.max_per_pixel, args.dump_fragment_layers);
+            desc.color_format = target_color.value_or(desc.color_format);
+            desc.depth_format = target_depth.value_or(desc.depth_format);
+            raster::FragmentLists lists;
+            raster::FrameStats ts;
+            if (Status s = renderer.renderFragmentLists(*scene, *view, options, desc, lists, &ts);
+                !s.ok())
+                return fail(s.message());
+            if (Status s = dumpFragments(lists, *view, args.dump_fragments,
+                                         args.dump_fragment_layers);
+                !s.ok())
+                return fail(s.message());
+            target_stats["fragment_lists"] = {
+                {"collected", lists.fragments_collected},
+                {"kept", lists.fragments_kept},
+                {"max_list_length", lists.max_list_length},
+                {"bytes", ts.target_bytes},
+                {"time_ms", {{"collect", ts.ms_raster}, {"resolve", ts.ms_resolve}}}};
+        }
+    }
     if (!args.stats_path.empty()) {
         const raster::View& v = *view;
         nlohmann::json j;
         j["scene"] = args.scene;
-        j["output"] = args.output;
+        j["output"] = args.outputs.front();
+        j["outputs"] = args.outputs;
+        j["simd"] = !args.no_simd;
+        if (!target_stats.is_null())
+            j["targets"] = target_stats;
         j["method"] = args.method;
         j["width"] = args.width;
         j["height"] = args.height;
@@ -684,7 +766,9 @@ int runRender(const RenderArgs& args) {
         if (Status s = writeTextFile(args.stats_path, j.dump(2) + "\n"); !s.ok())
             return fail(s.message());
     }
-    std::printf("focal: wrote %s", args.output.c_str());
+    std::printf("focal: wrote %s", args.outputs.front().c_str());
+    for (size_t i = 1; i < args.outputs.size(); ++i)
+        std::printf(", %s", args.outputs[i].c_str());
     if (!args.depth_out.empty())
         std::printf(" and %s", args.depth_out.c_str());
     if (is_accum)

@@ -9,12 +9,13 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace focal {
 
 struct RenderArgs {
     std::string scene;
-    std::string output;
+    std::vector<std::string> outputs;  // -o, repeatable: the same image in several files
     uint32_t width = 800;
     uint32_t height = 600;
     std::optional<int> camera;
@@ -48,6 +49,12 @@ struct RenderArgs {
     std::string aperture_image;
     uint32_t seed = 0;
     bool no_progress = false;
+    bool no_simd = false;
+    // Looking inside the GPU-emulating targets (docs/targets.md).
+    std::string dump_layers;
+    uint32_t dump_layer_count = 8;
+    std::string dump_fragments;
+    uint32_t dump_fragment_layers = 4;
     // Storage of layered targets / fragment lists for the methods in apps/methods.cpp:
     // --precision 16|32 sets both; --target-color half|float32, --target-depth unorm16|float32
     // override one. Unset: the method's default.

@@ -33,10 +33,12 @@ std::string numbered(const std::string& dir, const char* stem, uint32_t i, const
     return (std::filesystem::path(dir) / name).string();
 }
 
+// Creates the dump folder (and its parents) when missing.
 Status checkDir(const std::string& dir) {
     std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
     if (!std::filesystem::is_directory(dir, ec))
-        return Status::error(dir + ": dump folder does not exist");
+        return Status::error(dir + ": cannot create the dump folder");
     return {};
 }
 

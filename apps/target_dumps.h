@@ -1,6 +1,6 @@
 // `--dump-layers DIR` and `--dump-fragments DIR`: write what the GPU-emulating targets hold as
 // images, for looking inside (docs/targets.md). Consumes a LayeredTarget or FragmentLists plus
-// the View they were rendered with; writes files into an existing folder.
+// the View they were rendered with; writes files into a folder (created when missing).
 #pragma once
 
 #include <raster/camera.h>
