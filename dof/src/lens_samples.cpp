@@ -1,5 +1,7 @@
 #include <dof/lens_samples.h>
 
+#include <raster/hash.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -12,16 +14,7 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-// 32-bit integer finaliser (xorshift-multiply, as in Wellons' "lowbias32" search): full
-// avalanche, cheap, and a pure function.
-uint32_t mix32(uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
+using raster::hash32;
 
 float fract(float x) {
     return x - std::floor(x);
@@ -145,10 +138,10 @@ glm::vec2 concentricDisk(glm::vec2 u) {
 }
 
 uint32_t hashWords(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
-    uint32_t h = mix32(a + 0x9e3779b9u);
-    h = mix32(h ^ (b + 0x85ebca6bu));
-    h = mix32(h ^ (c + 0xc2b2ae35u));
-    return mix32(h ^ (d + 0x27d4eb2fu));
+    uint32_t h = hash32(a + 0x9e3779b9u);
+    h = hash32(h ^ (b + 0x85ebca6bu));
+    h = hash32(h ^ (c + 0xc2b2ae35u));
+    return hash32(h ^ (d + 0x27d4eb2fu));
 }
 
 float hashToUnit(uint32_t h) {

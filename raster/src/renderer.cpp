@@ -116,10 +116,14 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
 
 namespace {
 
-// Adds the per-tile fragment counters in tile order.
-void addCounters(const std::vector<TileCounters>& tiles, FrameStats* stats) {
+// Records the target's times and size, and adds the per-tile fragment counters in tile order.
+void finishStats(const std::vector<TileCounters>& tiles, double ms_raster, double ms_resolve,
+                 uint64_t target_bytes, FrameStats* stats) {
     if (!stats)
         return;
+    stats->ms_raster = ms_raster;
+    stats->ms_resolve = ms_resolve;
+    stats->target_bytes = target_bytes;
     for (const TileCounters& tc : tiles) {
         stats->fragments_covered += tc.covered;
         stats->fragments_passed += tc.passed;
@@ -180,11 +184,8 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
         FrameSink sink{out, options.peel_depth};
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
     });
-    if (stats) {
-        stats->ms_raster = msSince(t0);
-        stats->target_bytes = out.color.size() * sizeof(float) + out.depth.bytes();
-    }
-    addCounters(st.tile_counters, stats);
+    finishStats(st.tile_counters, msSince(t0), 0.0,
+                out.color.size() * sizeof(float) + out.depth.bytes(), stats);
     return {};
 }
 
@@ -250,12 +251,7 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
                 }
         });
     }
-    if (stats) {
-        stats->ms_raster = ms_raster;
-        stats->ms_resolve = msSince(t0);
-        stats->target_bytes = out.bytes();
-    }
-    addCounters(st.tile_counters, stats);
+    finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
     return {};
 }
 
@@ -355,12 +351,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                 }
             }
     });
-    if (stats) {
-        stats->ms_raster = ms_raster;
-        stats->ms_resolve = msSince(t0);
-        stats->target_bytes = out.bytes();
-    }
-    addCounters(st.tile_counters, stats);
+    finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
     return {};
 }
 

@@ -51,14 +51,6 @@ float fraction(uint32_t i, uint32_t n) {
 
 } // namespace
 
-uint32_t hash32(uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352dU;
-    x ^= x >> 15;
-    x *= 0x846ca68bU;
-    x ^= x >> 16;
-    return x;
-}
 
 float hashUnit(uint32_t key, uint32_t stream) {
     const uint32_t h = hash32(key ^ hash32(stream + 0x9e3779b9U));

@@ -5,6 +5,7 @@
 // from outside (glTF front face). Only sin/cos/sqrt are used, so the bytes match on any platform.
 #pragma once
 
+#include <raster/hash.h>
 #include <raster/scene.h>
 
 #include <glm/mat4x4.hpp>
@@ -18,8 +19,8 @@ namespace scenes::detail {
 
 inline constexpr float kPi = 3.14159265358979f;
 
-// Deterministic integer hash (Chris Wellons' "lowbias32"); no RNG state anywhere.
-uint32_t hash32(uint32_t x);
+// Deterministic integer hash; no RNG state anywhere.
+using raster::hash32;
 // A float in [0, 1) that is a pure function of (key, stream): 24 hash bits, exactly representable.
 float hashUnit(uint32_t key, uint32_t stream);
 // hashUnit mapped to [lo, hi).
