@@ -343,8 +343,7 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--dump-fragments", args.dump_fragments,
                     "write per-pixel fragment-list counts and the first K fragment layers into "
                     "this folder");
-    cmd->add_option("--dump-fragment-layers", args.dump_fragment_layers,
-                    "K for --dump-fragments")
+    cmd->add_option("--dump-fragment-layers", args.dump_fragment_layers, "K for --dump-fragments")
         ->capture_default_str()
         ->check(CLI::Range(0, 64));
     cmd->add_option("--precision", args.precision,
@@ -546,8 +545,8 @@ int runRender(const RenderArgs& args) {
                 return fail(r.status().message());
             accum_stats = *r;
         } else if (table_method) {
-            MethodInput in{*scene, *view,   choice.lens,  *lens_samples,
-                           pool,   options, target_color, target_depth, &*aperture_shape};
+            MethodInput in{*scene,  *view,        choice.lens,  *lens_samples,   pool,
+                           options, target_color, target_depth, &*aperture_shape};
             method_out = MethodOutput{};
             if (Status s = table_method->run(in, method_out); !s.ok())
                 return fail(s.message());
@@ -632,9 +631,8 @@ int runRender(const RenderArgs& args) {
             if (!range.covered)
                 return fail(args.scene + ": nothing visible to decompose into layers");
             raster::LayeredTargetDesc desc;
-            desc.bounds = uniformInverseDepthBounds(range.near_d, std::max(range.far_d,
-                                                    range.near_d * 1.001f),
-                                                    args.dump_layer_count);
+            desc.bounds = uniformInverseDepthBounds(
+                range.near_d, std::max(range.far_d, range.near_d * 1.001f), args.dump_layer_count);
             desc.color_format = target_color.value_or(raster::ColorFormat::Float32);
             desc.depth_format = target_depth.value_or(raster::DepthFormat::Float32);
             raster::LayeredTarget layers;
@@ -644,11 +642,11 @@ int runRender(const RenderArgs& args) {
                 return fail(s.message());
             if (Status s = dumpLayers(layers, *view, args.dump_layers); !s.ok())
                 return fail(s.message());
-            target_stats["layers"] = {{"count", layers.layer_count},
-                                      {"bounds", desc.bounds},
-                                      {"bytes", ts.target_bytes},
-                                      {"time_ms", {{"raster", ts.ms_raster},
-                                                   {"copy", ts.ms_resolve}}}};
+            target_stats["layers"] = {
+                {"count", layers.layer_count},
+                {"bounds", desc.bounds},
+                {"bytes", ts.target_bytes},
+                {"time_ms", {{"raster", ts.ms_raster}, {"copy", ts.ms_resolve}}}};
         }
         if (!args.dump_fragments.empty()) {
             raster::FragmentListDesc desc;
@@ -660,8 +658,8 @@ int runRender(const RenderArgs& args) {
             if (Status s = renderer.renderFragmentLists(*scene, *view, options, desc, lists, &ts);
                 !s.ok())
                 return fail(s.message());
-            if (Status s = dumpFragments(lists, *view, args.dump_fragments,
-                                         args.dump_fragment_layers);
+            if (Status s =
+                    dumpFragments(lists, *view, args.dump_fragments, args.dump_fragment_layers);
                 !s.ok())
                 return fail(s.message());
             target_stats["fragment_lists"] = {
