@@ -8,5 +8,9 @@ cmake --preset release >/dev/null
 cmake --build --preset release --target focal -- -j"$(nproc)"
 mkdir -p out
 focal=build/release/apps/focal
-"$focal" render builtin:demo -o out/demo.exr -o out/demo.png --stats out/demo.json
+# The accumulation reference (the thin-lens integral, docs/dof/accum.md) with 256 lens samples and
+# anti-aliasing: the most accurate depth of field focal renders. Faster methods: --method
+# multilayer, multiview or gather (docs/benchmarks.md compares them).
+"$focal" render builtin:demo --method accum --samples 256 --pixel-jitter \
+    -o out/demo.exr -o out/demo.png --stats out/demo.json
 echo "demo: images in $(pwd)/out/demo.png and $(pwd)/out/demo.exr (stats in out/demo.json)"
