@@ -80,8 +80,9 @@ TEST(Coverage, JitteredMeshIsWatertight) {
         for (uint32_t x = 0; x < kSize; ++x) {
             const float v = pixel(f, x, y).r;
             EXPECT_TRUE(v == 0.0f || v == 0.5f) << x << "," << y << " = " << v;
-            if (x >= 5 && x < 57 && y >= 5 && y < 57)
+            if (x >= 5 && x < 57 && y >= 5 && y < 57) {
                 EXPECT_EQ(v, 0.5f) << x << "," << y;
+            }
         }
 }
 
@@ -190,7 +191,7 @@ INSTANTIATE_TEST_SUITE_P(
                       // (now clockwise on screen) stays visible and the back one is culled.
                       CullCase{"front_mirrored", false, false, true, true},
                       CullCase{"back_mirrored", true, false, true, false}),
-    [](const auto& info) { return std::string(info.param.name); });
+    [](const auto& test) { return std::string(test.param.name); });
 
 }  // namespace
 }  // namespace focal::test

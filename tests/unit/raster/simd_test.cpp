@@ -46,8 +46,9 @@ TEST(Simd, QuadKernelMatchesScalarBitForBit) {
         raster::quadKernelScalar(in, a);
         wide(in, b);
         ASSERT_EQ(a.mask, b.mask) << i;
-        if (a.mask != 0)
+        if (a.mask != 0) {
             ASSERT_EQ(std::memcmp(&a, &b, sizeof(a)), 0) << i;
+        }
     }
 }
 

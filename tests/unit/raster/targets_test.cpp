@@ -108,10 +108,11 @@ TEST(LayeredTarget, ExactRoutingEqualsRendersClippedToEachLayer) {
                 ++mismatched;  // only where a clipped triangle's new edge is snapped differently
                 continue;
             }
-            if (in_ref)
+            if (in_ref) {
                 EXPECT_EQ(glm::vec3(c), glm::vec3(pixel(ref, uint32_t(p % v.width),
                                                          uint32_t(p / v.width))))
                     << "layer " << l << " pixel " << p;
+            }
         }
         EXPECT_GT(covered, 0u) << "layer " << l;
         EXPECT_LE(mismatched, t.width) << "layer " << l;  // at most a row's worth along the cut

@@ -21,14 +21,15 @@ using raster::Wrap;
 template <class F> Image makeImage(uint32_t w, uint32_t h, bool srgb, F value) {
     Image img;
     img.srgb = srgb;
-    raster::MipLevel level;
+    raster::MipLevel& level = img.levels.emplace_back();
     level.width = w;
     level.height = h;
+    level.rgba8.resize(size_t(w) * h * 4);
     for (uint32_t y = 0; y < h; ++y)
-        for (uint32_t x = 0; x < w; ++x)
-            level.rgba8.insert(level.rgba8.end(), {uint8_t(value(x, y)), uint8_t(x), uint8_t(y),
-                                                   uint8_t(255)});
-    img.levels.push_back(level);
+        for (uint32_t x = 0; x < w; ++x) {
+            uint8_t* t = &level.rgba8[(size_t(y) * w + x) * 4];
+            t[0] = uint8_t(value(x, y)), t[1] = uint8_t(x), t[2] = uint8_t(y), t[3] = 255;
+        }
     raster::buildMipChain(img);
     return img;
 }
