@@ -1,5 +1,6 @@
 #include "apps/cli.h"
 
+#include "apps/bench_command.h"
 #include "apps/compare_command.h"
 #include "apps/render_command.h"
 #include "apps/scene_info.h"
@@ -36,6 +37,9 @@ int runCli(int argc, char** argv) {
     CompareArgs compare_args;
     CLI::App* compare = addCompareCommand(app, compare_args);
 
+    BenchArgs bench_args;
+    CLI::App* bench = addBenchCommand(app, bench_args);
+
     std::string info_scene;
     CLI::App* info = app.add_subcommand("info", "Describe a scene: triangles, meshes, materials, "
                                                 "textures, cameras, bounds, extensions");
@@ -57,6 +61,8 @@ int runCli(int argc, char** argv) {
         return runRender(render_args);
     if (compare->parsed())
         return runCompare(compare_args);
+    if (bench->parsed())
+        return runBench(bench_args);
     if (info->parsed())
         return runInfo(info_scene);
     return 2;

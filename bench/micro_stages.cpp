@@ -1,0 +1,230 @@
+// Micro-benchmarks of the hot stages (issue 9 item 6), with Google Benchmark: geometry
+// (transform/clip/cull), binning, tile raster coverage (unlit) and coverage + shading (material),
+// layer decomposition (Lee et al. 2009 §4.2 layered rendering), fragment-list building (Selgrad
+// et al. 2015 §4), the gather filter (Zhou et al. 2007), multiview ray traversal and multilayer
+// list filtering (whole methods; their per-stage times are reported as counters), and the error
+// metrics. Everything runs inline (TaskPool(0)) on one thread at 400x300 from each scene's
+// default camera, so numbers are per-core costs. Run:
+//   build/bench/focal_microbench --benchmark_filter=Binning
+#include "apps/dof_method.h"
+#include "apps/scene_source.h"
+#include "raster/src/binning.h"
+#include "raster/src/geometry.h"
+
+#include <dof/gather.h>
+#include <dof/lens.h>
+#include <dof/lens_samples.h>
+#include <dof/metrics.h>
+#include <raster/camera.h>
+#include <raster/check.h>
+#include <raster/fragment_lists.h>
+#include <raster/layered_target.h>
+#include <raster/renderer.h>
+#include <raster/task_pool.h>
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+#include <string>
+
+namespace {
+
+constexpr uint32_t kWidth = 400;
+constexpr uint32_t kHeight = 300;
+
+// One loaded scene with its default view and lens, built on first use and kept.
+struct Setup {
+    raster::Scene scene;
+    raster::View view;
+    dof::ThinLens lens;
+};
+
+const Setup& setupFor(const std::string& name) {
+    static std::map<std::string, std::unique_ptr<Setup>> cache;
+    auto& slot = cache[name];
+    if (!slot) {
+        raster::Result<raster::Scene> scene = focal::loadScene("builtin:" + name);
+        FOCAL_CHECK(scene.ok());
+        slot = std::make_unique<Setup>();
+        slot->scene = std::move(*scene);
+        slot->view = raster::viewFromCamera(slot->scene.cameras[0], kWidth, kHeight);
+        const float aperture = slot->scene.lens ? slot->scene.lens->aperture_radius : 0.05f;
+        const float focus =
+            slot->scene.lens ? slot->scene.lens->focus_distance : slot->view.focus_distance;
+        slot->view.focus_distance = focus;
+        slot->lens = dof::makeThinLens(slot->view, aperture, focus);
+    }
+    return *slot;
+}
+
+const char* sceneName(int64_t i) {
+    static const char* kScenes[] = {"demo", "railing", "foliage", "dense"};
+    return kScenes[i];
+}
+
+void sceneArgs(benchmark::internal::Benchmark* b) {
+    for (int i = 0; i < 4; ++i)
+        b->Arg(i);
+    b->Unit(benchmark::kMillisecond);
+}
+
+void BM_Geometry(benchmark::State& state) {
+    const Setup& s = setupFor(sceneName(state.range(0)));
+    state.SetLabel(sceneName(state.range(0)));
+    raster::TaskPool pool(0);
+    raster::GeometryState geometry;
+    for (auto _ : state) {
+        raster::runGeometry(pool, s.scene, s.view, geometry);
+        benchmark::DoNotOptimize(geometry.chunks.data());
+    }
+}
+BENCHMARK(BM_Geometry)->Apply(sceneArgs);
+
+void BM_Binning(benchmark::State& state) {
+    const Setup& s = setupFor(sceneName(state.range(0)));
+    state.SetLabel(sceneName(state.range(0)));
+    raster::TaskPool pool(0);
+    raster::GeometryState geometry;
+    raster::runGeometry(pool, s.scene, s.view, geometry);
+    const raster::TileGrid grid = raster::makeTileGrid(kWidth, kHeight, 64);
+    std::vector<raster::ChunkBins> bins;
+    for (auto _ : state) {
+        raster::binChunks(pool, geometry, grid, bins);
+        benchmark::DoNotOptimize(bins.data());
+    }
+}
+BENCHMARK(BM_Binning)->Apply(sceneArgs);
+
+// Whole pinhole frame; the FrameStats split is reported as counters (ms per frame).
+void rasterBench(benchmark::State& state, raster::ShadingMode shading) {
+    const Setup& s = setupFor(sceneName(state.range(0)));
+    state.SetLabel(sceneName(state.range(0)));
+    raster::TaskPool pool(0);
+    raster::Renderer renderer(pool);
+    raster::RenderOptions options;
+    options.shading = shading;
+    raster::Frame frame;
+    raster::FrameStats stats;
+    double raster_ms = 0.0;
+    for (auto _ : state) {
+        FOCAL_CHECK(renderer.render(s.scene, s.view, options, frame, &stats).ok());
+        raster_ms += stats.ms_raster;
+    }
+    state.counters["tile_raster_ms"] = raster_ms / double(state.iterations());
+}
+// Coverage + depth with trivial shading, then with the materials' shading.
+void BM_RasterCoverageUnlit(benchmark::State& state) {
+    rasterBench(state, raster::ShadingMode::Unlit);
+}
+void BM_RasterShadingMaterial(benchmark::State& state) {
+    rasterBench(state, raster::ShadingMode::Material);
+}
+BENCHMARK(BM_RasterCoverageUnlit)->Apply(sceneArgs);
+BENCHMARK(BM_RasterShadingMaterial)->Apply(sceneArgs);
+
+// Layer decomposition: 8 layers uniform in 1/d between near focus and far (Lee et al. Eq. 4).
+void BM_LayerDecomposition(benchmark::State& state) {
+    const Setup& s = setupFor(sceneName(state.range(0)));
+    state.SetLabel(sceneName(state.range(0)));
+    raster::TaskPool pool(0);
+    raster::Renderer renderer(pool);
+    raster::LayeredTargetDesc desc;
+    const float n = s.view.znear, f = s.view.zfar > 0.0f ? s.view.zfar : 1000.0f;
+    for (int l = 0; l <= 8; ++l) {
+        const float t = float(l) / 8.0f;
+        desc.bounds.push_back(1.0f / ((1.0f - t) / n + t / f));
+    }
+    raster::LayeredTarget target;
+    for (auto _ : state)
+        FOCAL_CHECK(renderer.renderLayers(s.scene, s.view, {}, desc, target).ok());
+}
+BENCHMARK(BM_LayerDecomposition)->Apply(sceneArgs);
+
+void BM_FragmentLists(benchmark::State& state) {
+    const Setup& s = setupFor(sceneName(state.range(0)));
+    state.SetLabel(sceneName(state.range(0)));
+    raster::TaskPool pool(0);
+    raster::Renderer renderer(pool);
+    raster::FragmentListDesc desc;
+    raster::FragmentLists lists;
+    for (auto _ : state)
+        FOCAL_CHECK(renderer.renderFragmentLists(s.scene, s.view, {}, desc, lists).ok());
+}
+BENCHMARK(BM_FragmentLists)->Apply(sceneArgs);
+
+void BM_GatherFilter(benchmark::State& state) {
+    const Setup& s = setupFor(sceneName(state.range(0)));
+    state.SetLabel(sceneName(state.range(0)));
+    raster::TaskPool pool(0);
+    raster::Renderer renderer(pool);
+    raster::Frame frame;
+    FOCAL_CHECK(renderer.render(s.scene, s.view, {}, frame).ok());
+    const dof::GatherImage image{frame.color.data(), dof::depthRefOf(frame.depth), kWidth, kHeight};
+    dof::GatherSettings settings;
+    std::vector<float> out;
+    for (auto _ : state)
+        FOCAL_CHECK(dof::gather(image, s.lens, s.view, settings, out).ok());
+}
+BENCHMARK(BM_GatherFilter)->Apply(sceneArgs);
+
+// A table method with its default options; its stage times become counters.
+void methodBench(benchmark::State& state, const std::string& method) {
+    const Setup& s = setupFor(sceneName(state.range(0)));
+    state.SetLabel(sceneName(state.range(0)));
+    const focal::MethodEntry* entry = nullptr;
+    for (const focal::MethodEntry& m : focal::methodTable())
+        if (m.name == method)
+            entry = &m;
+    FOCAL_CHECK(entry != nullptr);
+    raster::TaskPool pool(0);
+    raster::Result<dof::LensSampleSet> samples =
+        dof::LensSampleSet::create(dof::ApertureShape{}, dof::LensPattern::Hammersley, 32, 0);
+    FOCAL_CHECK(samples.ok());
+    raster::RenderOptions options;
+    std::map<std::string, double> stage_sum;
+    for (auto _ : state) {
+        focal::MethodInput in{s.scene, s.view, s.lens, *samples, pool, options, {}, {}};
+        focal::MethodOutput out;
+        FOCAL_CHECK(entry->run(in, out).ok());
+        for (const auto& [stage, ms] : out.stage_ms)
+            stage_sum[stage] += ms;
+    }
+    for (const auto& [stage, ms] : stage_sum)
+        state.counters[stage + "_ms"] = ms / double(state.iterations());
+}
+// Multiview = layer decomposition + N-buffers + lens-ray traversal (counter "tracing_ms").
+void BM_MultiviewRayTraversal(benchmark::State& state) {
+    methodBench(state, "multiview");
+}
+// Multilayer = fragment lists + level building + list filtering (Selgrad et al. §5).
+void BM_MultilayerListFiltering(benchmark::State& state) {
+    methodBench(state, "multilayer");
+}
+BENCHMARK(BM_MultiviewRayTraversal)->Apply(sceneArgs);
+BENCHMARK(BM_MultilayerListFiltering)->Apply(sceneArgs);
+
+void BM_Metrics(benchmark::State& state) {
+    const Setup& s = setupFor("demo");
+    raster::TaskPool pool(0);
+    raster::Renderer renderer(pool);
+    raster::Frame a, b;
+    FOCAL_CHECK(renderer.render(s.scene, s.view, {}, a).ok());
+    raster::View shifted = s.view;
+    shifted.pixel_shift = {0.5f, 0.0f};
+    FOCAL_CHECK(renderer.render(s.scene, shifted, {}, b).ok());
+    const dof::ImageRef ra{a.color.data(), kWidth, kHeight, 4};
+    const dof::ImageRef rb{b.color.data(), kWidth, kHeight, 4};
+    for (auto _ : state) {
+        raster::Result<dof::ErrorMetrics> m = dof::compareImages(ra, rb);
+        FOCAL_CHECK(m.ok());
+        benchmark::DoNotOptimize(m->ssim);
+    }
+    state.SetLabel("PSNR + SSIM, 400x300");
+    state.SetItemsProcessed(state.iterations() * int64_t(kWidth) * kHeight);
+}
+BENCHMARK(BM_Metrics)->Unit(benchmark::kMillisecond);
+
+} // namespace
+
+BENCHMARK_MAIN();
