@@ -232,6 +232,33 @@ glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::v
     return c;
 }
 
+// §4.4 + §5: the shaded colour of a cone of radius `radius` px around image position (px, py)
+// in layer l. ConeShading::Footprint averages the covered texels among five taps (the centre and
+// +-radius/2 along x and y), each shaded at its own stored depth; Centre shades the hit texel.
+glm::vec3 shadeFootprint(const Tracer& tr, uint32_t l, uint32_t texel, float t, float px, float py,
+                         float radius, glm::vec3 eye) {
+    if (tr.settings->cone_shading == ConeShading::Centre || radius <= 0.5f)
+        return shadeHit(tr, l, texel, t, eye);
+    const raster::LayeredTarget& lt = *tr.layers;
+    const std::vector<float>& depth = tr.scratch->depth[l];
+    const float hr = 0.5f * radius;
+    const std::array<glm::vec2, 5> taps = {
+        {{0.0f, 0.0f}, {-hr, 0.0f}, {hr, 0.0f}, {0.0f, -hr}, {0.0f, hr}}};
+    glm::vec3 sum(0.0f);
+    uint32_t count = 0;
+    for (const glm::vec2& o : taps) {
+        const float x = std::floor(px + o.x), y = std::floor(py + o.y);
+        if (x < 0.0f || y < 0.0f || x >= float(tr.width) || y >= float(tr.height))
+            continue;
+        const uint32_t ti = uint32_t(y) * tr.width + uint32_t(x);
+        if (!(lt.color.load(lt.index(l, ti)).a > 0.0f))
+            continue;
+        sum += shadeHit(tr, l, ti, depth[ti], eye);
+        ++count;
+    }
+    return count > 0 ? sum / float(count) : shadeHit(tr, l, texel, t, eye);
+}
+
 // The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
 LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
                           const std::array<float, 4>& noise, uint32_t halton_offset) {
@@ -319,6 +346,10 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
     const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
     double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
     const uint32_t n = tr.samples->size();
+    std::vector<MultiviewRayRecord>* records =
+        s.debug_rays && x == s.debug_x && y == s.debug_y ? s.debug_rays : nullptr;
+    if (records)
+        records->assign(n, MultiviewRayRecord{});
     for (uint32_t k = 0; k < n; ++k) {
         ++cnt.rays;
         const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
@@ -329,8 +360,17 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             return px >= 0.0f && py >= 0.0f && px < float(tr.width) && py < float(tr.height);
         };
         const bool discard = s.offscreen == OffscreenPolicy::Discard;
+        MultiviewRayRecord* rec = records ? &(*records)[k] : nullptr;
+        if (rec) {
+            rec->lens = ls.position;
+            rec->weight = ls.weight;
+            rec->t_start = t_first;
+            rec->start_px = glm::vec2(cx, cy) + tr.cocOf(t_first) * w;
+        }
         if (discard && !inside(t_first)) { // the path starts outside the image
             ++cnt.discarded;
+            if (rec)
+                rec->discarded = true, rec->t_end = t_first, rec->end_px = rec->start_px;
             continue;
         }
         const glm::vec3 lens_point =
@@ -367,7 +407,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             const float c_hit = tr.cocOf(h.t);
             glm::vec3 c1;
             float v1 = 1.0f;
-            if (s.cone && tr.lambda * std::fabs(c_hit) > 1.0f) {
+            const bool cone_hit = s.cone && tr.lambda * std::fabs(c_hit) > 1.0f;
+            if (cone_hit) {
                 // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha
                 // is its coverage v1, the mipmapped RGB / v1 its mean colour c1.
                 const glm::vec4 m = sampleCone(tr, l, cx + c_hit * w.x, cy + c_hit * w.y,
@@ -377,8 +418,15 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             } else {
                 c1 = glm::vec3(lt.color.load(lt.index(l, h.texel)));
             }
-            if (shade)
-                c1 = shadeHit(tr, l, h.texel, h.t, s.view_dependent ? lens_point : view.eye);
+            if (shade) {
+                const glm::vec3 from = s.view_dependent ? lens_point : view.eye;
+                c1 = cone_hit
+                         ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * w.x, cy + c_hit * w.y,
+                                          0.5f * tr.lambda * std::fabs(c_hit), from)
+                         : shadeHit(tr, l, h.texel, h.t, from);
+            }
+            if (rec)
+                rec->layer = int32_t(l);
             if (v1 >= kFullCoverage) {
                 color += transmit * c1;
                 transmit = 0.0f;
@@ -387,6 +435,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             }
             // v1 c1 + (1 - v1) c2: continue along the centre ray for c2.
             ++cnt.cone_partial;
+            if (rec)
+                ++rec->partial_hits;
             color += transmit * v1 * c1;
             transmit *= 1.0f - v1;
             t_resume = h.t + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
@@ -396,9 +446,17 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             ++cnt.background;
             color += transmit * tr.background;
             t_end = t_last;
+            if (rec)
+                rec->layer = -1;
+        }
+        if (rec) {
+            rec->t_end = t_end;
+            rec->end_px = glm::vec2(cx, cy) + tr.cocOf(t_end) * w;
         }
         if (discard && !inside(t_end)) { // the path to the hit leaves the image
             ++cnt.discarded;
+            if (rec)
+                rec->discarded = true;
             continue;
         }
         const double wt = double(ls.weight);

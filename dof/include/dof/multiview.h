@@ -48,6 +48,15 @@ enum class OffscreenPolicy : uint8_t {
     Clamp,   // the ray reads the nearest border texel instead
 };
 
+// How a cone hit (§4.4) is shaded when hits are re-shaded per ray (§5). The paper mipmaps the
+// G-buffer; shading a filtered G-buffer texel is not the filtered shading, so we instead shade
+// level-0 texels of the cone's footprint and average them.
+enum class ConeShading : uint8_t {
+    Centre,    // shade the centre ray's hit texel only (cheap; the footprint's colour is ignored)
+    Footprint, // shade the covered texels among 5 taps of the footprint (centre and +-r/2 in x
+               // and y, r the cone radius) and average them: the mean of what the cone sees
+};
+
 // An equirectangular environment map in linear RGB for reflections (§5, Fig. 9): row 0 is the
 // +y pole; u = 0.5 + atan2(dir.x, -dir.z) / 2pi. Plain data (loaded by the app).
 struct EnvironmentMap {
@@ -55,6 +64,20 @@ struct EnvironmentMap {
     uint32_t height = 0;
     std::vector<float> rgb; // width*height*3
     float intensity = 1.0f;
+};
+
+// One lens ray of pixel (MultiviewSettings::debug_x, debug_y), recorded for pictures (the ray is
+// the straight line p + C(t) w in (x, y, D), §4.3): where it starts and ends, and what it hit.
+struct MultiviewRayRecord {
+    glm::vec2 lens{0.0f};      // jittered lens position (lens units, §4.5)
+    float weight = 0.0f;       // the sample's weight
+    float t_start = 0.0f;      // stored D where the ray enters the first layer
+    float t_end = 0.0f;        // stored D of the hit that ended it (or of the last layer's end)
+    glm::vec2 start_px{0.0f};  // image position at t_start
+    glm::vec2 end_px{0.0f};    // image position at t_end
+    int32_t layer = -1;        // layer of the hit that ended it; -1: background
+    uint32_t partial_hits = 0; // cone hits with coverage < 1 passed through (§4.4)
+    bool discarded = false;    // left the image (OffscreenPolicy::Discard)
 };
 
 struct MultiviewSettings {
@@ -72,10 +95,15 @@ struct MultiviewSettings {
     uint32_t seed = 0; // jitter key
     OffscreenPolicy offscreen = OffscreenPolicy::Discard;
     bool view_dependent = false; // §5: shade each hit from its own lens point (needs G-buffer)
-    const EnvironmentMap* env_map = nullptr; // §5 reflections (implies a G-buffer)
+    ConeShading cone_shading = ConeShading::Footprint; // with cone && (view_dependent || env)
+    const EnvironmentMap* env_map = nullptr;           // §5 reflections (implies a G-buffer)
     // For JitterMode::Halton: 2N samples of the same pattern family and aperture as the main set.
     const LensSampleSet* sequence_2n = nullptr;
     uint32_t tile_size = 16; // output tile (the unit of parallel work and of tile culling)
+    // Debugging: when debug_rays is set, the rays of pixel (debug_x, debug_y) are recorded there
+    // in sample order (written only by the task that owns the pixel; no effect on the image).
+    uint32_t debug_x = 0, debug_y = 0;
+    std::vector<MultiviewRayRecord>* debug_rays = nullptr;
 };
 
 struct MultiviewStats {

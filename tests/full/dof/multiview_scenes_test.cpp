@@ -82,12 +82,18 @@ TEST(MultiviewScenes, BranchesMatchTheReference) {
     const Case c = load("branches", 320, 240);
     const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, makeSamples(256), {}, 2);
     raster::Frame pinhole;
-    const std::vector<float> mv = multiview(c, makeSamples(64), {}, &pinhole);
+    // Eq. 4 spaces layers by delta pixels of CoC, so at 320x240 (f_px 0.4x that of 800x600) a
+    // delta = 2 px layer is 2.5x deeper than at the benchmark's 800x600; delta = 1 px here slices
+    // depth like delta = 2.5 px there. Measured against this reference: SSIM 0.959 / 31.0 dB
+    // with delta = 2, 0.978 / 34.4 dB with delta = 1 (routing, iterations and N barely matter;
+    // docs/benchmarks.md, "Multiview synthesis").
+    dof::MultiviewSettings s;
+    s.layer_spacing_px = 1.0f;
+    const std::vector<float> mv = multiview(c, makeSamples(64), s, &pinhole);
     const dof::ErrorMetrics e = compare(mv, ref);
     const dof::ErrorMetrics p = compare(pinhole.color, ref);
-    // Measured: 0.959 SSIM at 320x240 (64 jittered rays against 256 shared-pattern views).
-    EXPECT_GT(e.psnr_linear_db, 30.0);
-    EXPECT_GT(e.ssim, 0.95);
+    EXPECT_GT(e.psnr_linear_db, 33.0);
+    EXPECT_GT(e.ssim, 0.97);
     EXPECT_GT(e.ssim, p.ssim);
 }
 

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 namespace focal::test {
@@ -139,6 +140,40 @@ TEST(Multiview, CullingIsLossless) {
     EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
     EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile, 0u);
     EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
+}
+
+TEST(Multiview, DebugRaysRecordOnePixelWithoutChangingTheImage) {
+    // The bar of ForegroundBlurRevealsHiddenBackground: pixel (8, 24) on its centre line sees
+    // the bar through some lens points and the wall behind through others (§4.1 hidden layers).
+    const raster::View view = pixelView(64, 48, 100.0f);
+    raster::Scene scene = wallScene();
+    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
+    addQuad(scene, -20.0f, -1.0f, -8.0f, 1.0f, 50.0f, green);
+    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, 100.0f);
+    const dof::LensSampleSet samples = makeSamples(64);
+    dof::MultiviewSettings s = exactSettings();
+    const MvRun plain = runMultiview(scene, view, lens, samples, s);
+    std::vector<dof::MultiviewRayRecord> rays;
+    s.debug_x = 8;
+    s.debug_y = 24;
+    s.debug_rays = &rays;
+    const MvRun debug = runMultiview(scene, view, lens, samples, s, 2);
+    EXPECT_EQ(hashFloats(plain.frame.color), hashFloats(debug.frame.color));
+    ASSERT_EQ(rays.size(), samples.size());
+    std::vector<uint32_t> per_layer(plain.stats.layers, 0);
+    for (uint32_t k = 0; k < rays.size(); ++k) {
+        const dof::MultiviewRayRecord& r = rays[k];
+        EXPECT_EQ(r.lens, samples.sample(k).position); // JitterMode::None: the shared set
+        EXPECT_LE(r.t_start, r.t_end);
+        if (r.discarded) // left the image (near the left border)
+            continue;
+        // Every kept ray meets the bar or the wall: nothing is behind the wall.
+        ASSERT_GE(r.layer, 0);
+        ++per_layer[size_t(r.layer)];
+    }
+    // Both the bar's layer and the wall's layer are hit.
+    EXPECT_GE(std::count_if(per_layer.begin(), per_layer.end(), [](uint32_t c) { return c > 0; }),
+              2);
 }
 
 TEST(Multiview, SameBytesForEveryThreadCount) {
