@@ -6,4 +6,4 @@ namespace focal {
 
 int runCli(int argc, char** argv);
 
-}  // namespace focal
+} // namespace focal

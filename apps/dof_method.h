@@ -5,21 +5,20 @@
 
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
-
 #include <raster/camera.h>
 #include <raster/renderer.h>
 #include <raster/scene.h>
 #include <raster/status.h>
 #include <raster/task_pool.h>
 
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
 #include <functional>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 namespace focal {
 
@@ -46,16 +45,16 @@ struct MethodInput {
 
 // What it returns for one run.
 struct MethodOutput {
-    std::vector<float> rgba;   // linear RGBA, view.width * view.height * 4, top row first
-    std::vector<float> depth;  // optional: linear distance along the view axis per pixel
-    nlohmann::json params;     // every parameter the method used (recorded in --stats)
-    nlohmann::json counts;     // method-specific counters (recorded in --stats)
-    std::vector<std::pair<std::string, double>> stage_ms;  // per-stage times, in stage order
+    std::vector<float> rgba;  // linear RGBA, view.width * view.height * 4, top row first
+    std::vector<float> depth; // optional: linear distance along the view axis per pixel
+    nlohmann::json params;    // every parameter the method used (recorded in --stats)
+    nlohmann::json counts;    // method-specific counters (recorded in --stats)
+    std::vector<std::pair<std::string, double>> stage_ms; // per-stage times, in stage order
 };
 
 struct MethodEntry {
     std::string name;
-    std::string summary;  // one line for --help
+    std::string summary; // one line for --help
     // Adds the method's options to `focal render` (values live in the method's own statics-free
     // args object owned by the entry).
     std::function<void(CLI::App& render)> add_options;
@@ -65,4 +64,4 @@ struct MethodEntry {
 // The methods beyond pinhole and accum, in a fixed order (apps/methods.cpp).
 std::vector<MethodEntry>& methodTable();
 
-}  // namespace focal
+} // namespace focal

@@ -2,13 +2,13 @@
 
 #include <raster/texture.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <system_error>
-
-#include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
 namespace focal {
@@ -18,9 +18,8 @@ using raster::Status;
 
 bool isLinearFormat(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
-        return char(std::tolower(c));
-    });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     return ext == ".exr" || ext == ".hdr";
 }
 
@@ -37,8 +36,7 @@ Status writeDirect(const std::string& path, const std::string& format_hint_path,
                    const ImageData& image) {
     auto out = OIIO::ImageOutput::create(format_hint_path);
     if (!out)
-        return Status::error("cannot write this image format (" + oneLine(OIIO::geterror()) +
-                             ")");
+        return Status::error("cannot write this image format (" + oneLine(OIIO::geterror()) + ")");
     const bool linear = isLinearFormat(format_hint_path);
     OIIO::ImageSpec spec(int(image.width), int(image.height), int(image.channels),
                          linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
@@ -70,7 +68,7 @@ Status writeDirect(const std::string& path, const std::string& format_hint_path,
     return {};
 }
 
-}  // namespace
+} // namespace
 
 Status writeImage(const std::string& path, const ImageData& image) {
     if (image.width == 0 || image.height == 0 ||
@@ -82,15 +80,14 @@ Status writeImage(const std::string& path, const ImageData& image) {
     if (!fs::is_directory(dir, ec))
         return Status::error(path + ": folder " + dir.string() + " does not exist");
     static std::atomic<uint32_t> counter{0};
-    const fs::path tmp = dir / ("." + target.stem().string() + ".tmp" +
-                                std::to_string(::getpid()) + "_" + std::to_string(counter++) +
-                                target.extension().string());
+    const fs::path tmp = dir / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) +
+                                "_" + std::to_string(counter++) + target.extension().string());
     Status s = writeDirect(tmp.string(), path, image);
     if (s.ok()) {
         fs::rename(tmp, target, ec);
         if (ec)
-            s = Status::error(path + ": cannot rename the finished image into place: " +
-                              ec.message());
+            s = Status::error(path +
+                              ": cannot rename the finished image into place: " + ec.message());
     } else {
         s = Status::error(path + ": " + s.message());
     }
@@ -126,4 +123,4 @@ raster::Result<ImageData> readImage(const std::string& path) {
     return img;
 }
 
-}  // namespace focal
+} // namespace focal

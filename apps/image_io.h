@@ -15,7 +15,7 @@ struct ImageData {
     uint32_t width = 0;
     uint32_t height = 0;
     uint32_t channels = 0;
-    std::vector<float> pixels;  // linear, interleaved, top row first
+    std::vector<float> pixels; // linear, interleaved, top row first
 };
 
 // Writes `image`. The format follows the extension (.exr float; .png/.jpg/.tif... 8-bit sRGB).
@@ -27,4 +27,4 @@ raster::Result<ImageData> readImage(const std::string& path);
 // True when `path` names a float format written linearly (EXR, HDR).
 bool isLinearFormat(const std::string& path);
 
-}  // namespace focal
+} // namespace focal

@@ -17,4 +17,4 @@ std::vector<MethodEntry>& methodTable() {
     return entries;
 }
 
-}  // namespace focal
+} // namespace focal

@@ -15,7 +15,7 @@ namespace focal {
 
 struct RenderArgs {
     std::string scene;
-    std::vector<std::string> outputs;  // -o, repeatable: the same image in several files
+    std::vector<std::string> outputs; // -o, repeatable: the same image in several files
     uint32_t width = 800;
     uint32_t height = 600;
     std::optional<int> camera;

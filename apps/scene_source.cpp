@@ -21,4 +21,4 @@ raster::Result<raster::Scene> loadScene(const std::string& spec) {
     return raster::importGltf(spec);
 }
 
-}  // namespace focal
+} // namespace focal

@@ -10,4 +10,4 @@ namespace focal {
 
 raster::Result<raster::Scene> loadScene(const std::string& spec);
 
-}  // namespace focal
+} // namespace focal

@@ -5,12 +5,12 @@
 
 #include <raster/texture.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-
-#include <nlohmann/json.hpp>
 
 namespace focal {
 
@@ -45,8 +45,8 @@ Status checkDir(const std::string& dir) {
 // A perceptual-ish heat map: black -> blue -> magenta -> orange -> white over [0, max].
 glm::vec3 heat(float t) {
     t = std::clamp(t, 0.0f, 1.0f);
-    const glm::vec3 stops[5] = {{0, 0, 0}, {0.05f, 0.1f, 0.6f}, {0.7f, 0.1f, 0.55f},
-                                {1.0f, 0.55f, 0.05f}, {1, 1, 0.9f}};
+    const glm::vec3 stops[5] = {
+        {0, 0, 0}, {0.05f, 0.1f, 0.6f}, {0.7f, 0.1f, 0.55f}, {1.0f, 0.55f, 0.05f}, {1, 1, 0.9f}};
     const float x = t * 4.0f;
     const int i = std::min(int(x), 3);
     const glm::vec3 a = stops[i], b = stops[i + 1];
@@ -54,7 +54,7 @@ glm::vec3 heat(float t) {
     return a + f * (b - a);
 }
 
-}  // namespace
+} // namespace
 
 Status dumpLayers(const raster::LayeredTarget& layers, const raster::View& view,
                   const std::string& dir) {
@@ -145,4 +145,4 @@ Status dumpFragments(const raster::FragmentLists& lists, const raster::View& vie
     return writeTextFile((base / "fragments.json").string(), index.dump(2) + "\n");
 }
 
-}  // namespace focal
+} // namespace focal

@@ -8,7 +8,6 @@
 #include <raster/layered_target.h>
 #include <raster/status.h>
 
-
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,4 +29,4 @@ raster::Status dumpLayers(const raster::LayeredTarget& layers, const raster::Vie
 raster::Status dumpFragments(const raster::FragmentLists& lists, const raster::View& view,
                              const std::string& dir, uint32_t first_k);
 
-}  // namespace focal
+} // namespace focal

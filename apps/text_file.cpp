@@ -3,7 +3,6 @@
 #include <filesystem>
 #include <fstream>
 #include <system_error>
-
 #include <unistd.h>
 
 namespace focal {
@@ -31,4 +30,4 @@ raster::Status writeTextFile(const std::string& path, const std::string& text) {
     return {};
 }
 
-}  // namespace focal
+} // namespace focal

@@ -9,4 +9,4 @@ namespace focal {
 
 raster::Status writeTextFile(const std::string& path, const std::string& text);
 
-}  // namespace focal
+} // namespace focal

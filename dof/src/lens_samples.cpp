@@ -1,5 +1,4 @@
 #include <dof/lens_samples.h>
-
 #include <raster/hash.h>
 
 #include <algorithm>

@@ -33,7 +33,9 @@ void makeEdges(const SetupTri& t, Edge edges[3]) {
 namespace {
 
 // Pixel centre of pixel index i, in fixed point.
-int64_t centre(int64_t i) { return i * kSubpixelOne + kSubpixelOne / 2; }
+int64_t centre(int64_t i) {
+    return i * kSubpixelOne + kSubpixelOne / 2;
+}
 
 // True when some pixel centre of the rectangle [x0,x1]x[y0,y1] may be inside all three edges.
 bool rectMayOverlap(const Edge edges[3], int64_t x0, int64_t y0, int64_t x1, int64_t y1) {
@@ -47,7 +49,7 @@ bool rectMayOverlap(const Edge edges[3], int64_t x0, int64_t y0, int64_t x1, int
     return true;
 }
 
-}  // namespace
+} // namespace
 
 void binChunks(TaskPool& pool, const GeometryState& geometry, const TileGrid& grid,
                std::vector<ChunkBins>& bins) {
@@ -91,4 +93,4 @@ void binChunks(TaskPool& pool, const GeometryState& geometry, const TileGrid& gr
     });
 }
 
-}  // namespace raster
+} // namespace raster

@@ -21,15 +21,15 @@ struct TileGrid {
 TileGrid makeTileGrid(uint32_t width, uint32_t height, uint32_t tile_size);
 
 struct ChunkBins {
-    std::vector<uint32_t> offsets;  // tile t owns items[offsets[t], offsets[t+1])
-    std::vector<uint32_t> items;    // indices into the chunk's SetupTri array
+    std::vector<uint32_t> offsets; // tile t owns items[offsets[t], offsets[t+1])
+    std::vector<uint32_t> items;   // indices into the chunk's SetupTri array
 };
 
 // Edge function E(p) = a*px + b*py + c of the edge from vertex i to vertex j, in 24.8 fixed
 // point; the interior is E >= 0 after adding `bias` (top-left rule, see docs/raster.md).
 struct Edge {
     int64_t a, b, c;
-    int64_t bias;  // 0 on top and left edges, -1 elsewhere: samples exactly on them stay out
+    int64_t bias; // 0 on top and left edges, -1 elsewhere: samples exactly on them stay out
     int64_t at(int64_t px, int64_t py) const { return a * px + b * py + c; }
 };
 
@@ -40,4 +40,4 @@ void makeEdges(const SetupTri& t, Edge edges[3]);
 void binChunks(TaskPool& pool, const GeometryState& geometry, const TileGrid& grid,
                std::vector<ChunkBins>& bins);
 
-}  // namespace raster
+} // namespace raster

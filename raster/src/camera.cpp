@@ -1,9 +1,9 @@
 #include <raster/camera.h>
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
-
-#include <glm/geometric.hpp>
 
 namespace raster {
 
@@ -12,10 +12,9 @@ float focalLengthPx(const View& view) {
 }
 
 glm::mat4 viewMatrix(const View& view) {
-    const glm::vec3 eye =
-        view.eye + view.lens_offset.x * view.right + view.lens_offset.y * view.up;
+    const glm::vec3 eye = view.eye + view.lens_offset.x * view.right + view.lens_offset.y * view.up;
     const glm::vec3 back = -view.forward;
-    glm::mat4 m(1.0f);  // column-major: m[col][row]
+    glm::mat4 m(1.0f); // column-major: m[col][row]
     m[0][0] = view.right.x, m[1][0] = view.right.y, m[2][0] = view.right.z;
     m[0][1] = view.up.x, m[1][1] = view.up.y, m[2][1] = view.up.z;
     m[0][2] = back.x, m[1][2] = back.y, m[2][2] = back.z;
@@ -39,16 +38,16 @@ glm::mat4 projectionMatrix(const View& view) {
     glm::mat4 p(0.0f);
     p[0][0] = f / half_w;
     p[1][1] = f / half_h;
-    p[2][0] = -shift_x;  // x_clip += shift_x * d, and d = -z_cam
+    p[2][0] = -shift_x; // x_clip += shift_x * d, and d = -z_cam
     p[2][1] = -shift_y;
-    p[2][3] = -1.0f;  // w_clip = d
+    p[2][3] = -1.0f; // w_clip = d
     if (view.zfar > 0.0f) {
         // z_clip = (d - n) * F / (F - n), so z_clip / w_clip = (1/n - 1/d) / (1/n - 1/F).
         const float k = view.zfar / (view.zfar - n);
         p[2][2] = -k;
         p[3][2] = -n * k;
     } else {
-        p[2][2] = -1.0f;  // z_clip = d - n: D = 1 - n/d
+        p[2][2] = -1.0f; // z_clip = d - n: D = 1 - n/d
         p[3][2] = -n;
     }
     return p;
@@ -84,14 +83,13 @@ View viewFromCamera(const Camera& camera, uint32_t width, uint32_t height) {
 View viewFramingBounds(const Bounds& bounds, uint32_t width, uint32_t height) {
     const glm::vec3 centre = 0.5f * (bounds.min + bounds.max);
     const float radius = std::max(0.5f * glm::length(bounds.max - bounds.min), 1e-3f);
-    const float yfov = 0.7853982f;  // 45 degrees
+    const float yfov = 0.7853982f; // 45 degrees
     const float aspect = float(width) / float(height);
     const float half_fov = std::min(0.5f * yfov, std::atan(std::tan(0.5f * yfov) * aspect));
     const float dist = 1.05f * radius / std::sin(half_fov);
     const glm::vec3 dir = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f));
-    return viewLookAt(centre + dist * dir, centre, glm::vec3(0.0f, 1.0f, 0.0f), yfov, width,
-                      height, std::max(dist - 2.0f * radius, 1e-3f * dist),
-                      dist + 2.0f * radius);
+    return viewLookAt(centre + dist * dir, centre, glm::vec3(0.0f, 1.0f, 0.0f), yfov, width, height,
+                      std::max(dist - 2.0f * radius, 1e-3f * dist), dist + 2.0f * radius);
 }
 
 View viewLookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float yfov, uint32_t width,
@@ -110,4 +108,4 @@ View viewLookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float yfov, uint3
     return v;
 }
 
-}  // namespace raster
+} // namespace raster

@@ -10,4 +10,4 @@ void checkFailed(const char* expr, const char* file, int line) {
     std::abort();
 }
 
-}  // namespace raster::detail
+} // namespace raster::detail

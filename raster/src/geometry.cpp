@@ -2,12 +2,12 @@
 
 #include <raster/check.h>
 
-#include <algorithm>
-#include <cmath>
-
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 namespace raster {
 
@@ -88,8 +88,12 @@ ScreenVertex toScreen(const glm::vec4& clip, float half_w, float half_h) {
             int32_t(std::lrint(py * float(kSubpixelOne))), clip.z * inv_w, inv_w};
 }
 
-int32_t ceilDiv(int64_t a, int64_t b) { return int32_t(a >= 0 ? (a + b - 1) / b : -((-a) / b)); }
-int32_t floorDiv(int64_t a, int64_t b) { return int32_t(a >= 0 ? a / b : -((-a + b - 1) / b)); }
+int32_t ceilDiv(int64_t a, int64_t b) {
+    return int32_t(a >= 0 ? (a + b - 1) / b : -((-a) / b));
+}
+int32_t floorDiv(int64_t a, int64_t b) {
+    return int32_t(a >= 0 ? a / b : -((-a + b - 1) / b));
+}
 
 struct ChunkContext {
     const Scene& scene;
@@ -103,8 +107,8 @@ struct ChunkContext {
 void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& draw,
                    bool double_sided, uint32_t triangle, float max_distance,
                    const ScreenVertex s[3], const uint32_t ref[3]) {
-    int64_t area2 = int64_t(s[1].x - s[0].x) * (s[2].y - s[0].y) -
-                    int64_t(s[1].y - s[0].y) * (s[2].x - s[0].x);
+    int64_t area2 =
+        int64_t(s[1].x - s[0].x) * (s[2].y - s[0].y) - int64_t(s[1].y - s[0].y) * (s[2].x - s[0].x);
     if (area2 == 0) {
         ++chunk.triangles_culled;
         return;
@@ -201,7 +205,7 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
     }
 }
 
-}  // namespace
+} // namespace
 
 void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryState& state) {
     // List the draws in submission order: instances, then their primitives.
@@ -251,8 +255,8 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
             const glm::vec4 world = inst.world * glm::vec4(prim.positions[local], 1.0f);
             out.world = glm::vec3(world);
             out.clip = view_proj * world;
-            out.normal = prim.normals.empty() ? glm::vec3(0.0f)
-                                              : draw.normal_matrix * prim.normals[local];
+            out.normal =
+                prim.normals.empty() ? glm::vec3(0.0f) : draw.normal_matrix * prim.normals[local];
             out.uv = prim.texcoords0.empty() ? glm::vec2(0.0f) : prim.texcoords0[local];
             out.color = prim.colors.empty() ? glm::vec4(1.0f) : prim.colors[local];
             VertexCodes& code = state.codes[vi];
@@ -290,4 +294,4 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
     });
 }
 
-}  // namespace raster
+} // namespace raster

@@ -15,13 +15,13 @@
 #include <raster/scene.h>
 #include <raster/task_pool.h>
 
-#include <cstdint>
-#include <vector>
-
 #include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <vector>
 
 namespace raster {
 
@@ -38,17 +38,17 @@ struct Draw {
     uint32_t instance = 0;
     uint32_t mesh = 0;
     uint32_t primitive = 0;
-    uint32_t first_vertex = 0;  // into GeometryState::vertices
-    uint64_t first_triangle = 0;  // submission index of its first triangle
-    bool mirrored = false;        // negative determinant: winding flips
-    glm::mat3 normal_matrix{1.0f};  // inverse transpose of the instance's upper 3x3
+    uint32_t first_vertex = 0;     // into GeometryState::vertices
+    uint64_t first_triangle = 0;   // submission index of its first triangle
+    bool mirrored = false;         // negative determinant: winding flips
+    glm::mat3 normal_matrix{1.0f}; // inverse transpose of the instance's upper 3x3
 };
 
 // A vertex after transform, with everything shading interpolates. Clipping makes new ones.
 struct ShadeVertex {
-    glm::vec4 clip;    // clip-space position
-    glm::vec3 world;   // world-space position
-    glm::vec3 normal;  // world-space normal (not normalised after interpolation)
+    glm::vec4 clip;   // clip-space position
+    glm::vec3 world;  // world-space position
+    glm::vec3 normal; // world-space normal (not normalised after interpolation)
     glm::vec2 uv;
     glm::vec4 color;
 };
@@ -56,8 +56,8 @@ struct ShadeVertex {
 // A vertex after the viewport transform: snapped position, stored depth and 1/w. Computed once
 // per vertex for unclipped triangles, so triangles sharing a vertex share its snapped position.
 struct ScreenVertex {
-    int32_t x, y;  // 24.8 fixed point pixels, y down
-    float z;       // stored depth D
+    int32_t x, y; // 24.8 fixed point pixels, y down
+    float z;      // stored depth D
     float inv_w;
 };
 
@@ -72,17 +72,17 @@ struct VertexCodes {
 
 // A screen-space triangle ready for coverage. Vertices are ordered so that area2 > 0.
 struct SetupTri {
-    int32_t x[3], y[3];   // 24.8 fixed point pixels, y down
-    int64_t area2;        // twice the signed area in fixed point^2, > 0
-    float z[3];           // stored depth D per vertex (z/w)
-    float inv_w[3];       // 1/w per vertex, for perspective-correct interpolation
-    uint32_t vertex[3];   // ShadeVertex references: kClipped bit => chunk-local clipped vertex
-    uint32_t draw;        // index into GeometryState::draws
-    uint32_t triangle;    // index of the source triangle within its draw
-    uint32_t primitive_id;  // submission index of the source triangle over the whole frame
-    float max_distance;   // largest view distance (w) of the source triangle's vertices
-    int32_t min_x, min_y, max_x, max_y;  // covered pixel bounds (inclusive), inside the viewport
-    bool front_facing;    // as seen by the viewer, for double-sided lighting
+    int32_t x[3], y[3];    // 24.8 fixed point pixels, y down
+    int64_t area2;         // twice the signed area in fixed point^2, > 0
+    float z[3];            // stored depth D per vertex (z/w)
+    float inv_w[3];        // 1/w per vertex, for perspective-correct interpolation
+    uint32_t vertex[3];    // ShadeVertex references: kClipped bit => chunk-local clipped vertex
+    uint32_t draw;         // index into GeometryState::draws
+    uint32_t triangle;     // index of the source triangle within its draw
+    uint32_t primitive_id; // submission index of the source triangle over the whole frame
+    float max_distance;    // largest view distance (w) of the source triangle's vertices
+    int32_t min_x, min_y, max_x, max_y; // covered pixel bounds (inclusive), inside the viewport
+    bool front_facing;                  // as seen by the viewer, for double-sided lighting
 };
 
 constexpr uint32_t kClippedVertex = 0x80000000u;
@@ -95,11 +95,11 @@ struct GeometryChunk {
 
 struct GeometryState {
     std::vector<Draw> draws;
-    std::vector<ShadeVertex> vertices;  // transformed vertices of every draw
-    std::vector<VertexCodes> codes;     // one per vertex
-    std::vector<ScreenVertex> screen;   // one per vertex; valid where codes.guard == 0
+    std::vector<ShadeVertex> vertices; // transformed vertices of every draw
+    std::vector<VertexCodes> codes;    // one per vertex
+    std::vector<ScreenVertex> screen;  // one per vertex; valid where codes.guard == 0
     std::vector<GeometryChunk> chunks;
-    glm::vec3 eye{0.0f};  // the eye shading uses (moved by the lens offset)
+    glm::vec3 eye{0.0f}; // the eye shading uses (moved by the lens offset)
 
     const ShadeVertex& vertex(const GeometryChunk& chunk, uint32_t ref) const {
         return (ref & kClippedVertex) ? chunk.clipped_vertices[ref & ~kClippedVertex]
@@ -110,4 +110,4 @@ struct GeometryState {
 // Runs the geometry stage for one view; fills state.draws, state.vertices and state.chunks.
 void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryState& state);
 
-}  // namespace raster
+} // namespace raster

@@ -30,4 +30,4 @@ uint32_t layerOf(const LayeredTargetDesc& desc, float d) {
     return uint32_t(std::clamp<int64_t>(l, 0, int64_t(desc.bounds.size()) - 2));
 }
 
-}  // namespace raster
+} // namespace raster

@@ -1,9 +1,9 @@
 #include "light_kernel.h"
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
-
-#include <glm/geometric.hpp>
 
 namespace raster {
 
@@ -12,7 +12,9 @@ namespace raster {
 #undef FOCAL_LIGHT_KERNEL_NAME
 
 #ifdef FOCAL_NO_SIMD
-LightKernel lightKernelAvx2() { return nullptr; }
+LightKernel lightKernelAvx2() {
+    return nullptr;
+}
 #endif
 
 LightKernel selectLightKernel(bool simd) {
@@ -53,4 +55,4 @@ std::vector<PreparedLight> prepareLights(const Scene& scene, glm::vec3 default_d
     return out;
 }
 
-}  // namespace raster
+} // namespace raster

@@ -7,10 +7,10 @@
 
 #include <raster/scene.h>
 
+#include <glm/vec3.hpp>
+
 #include <cstdint>
 #include <vector>
-
-#include <glm/vec3.hpp>
 
 namespace raster {
 
@@ -19,10 +19,10 @@ constexpr int kLightLanes = 8;
 // A light as the kernel uses it: radiance, unit direction of travel, cone and range constants.
 struct PreparedLight {
     Light::Type type = Light::Type::Directional;
-    float radiance[3] = {0, 0, 0};     // colour x intensity
-    float direction[3] = {0, 0, -1};   // unit, direction the light travels
+    float radiance[3] = {0, 0, 0};   // colour x intensity
+    float direction[3] = {0, 0, -1}; // unit, direction the light travels
     float position[3] = {0, 0, 0};
-    float inv_range2 = 0.0f;           // 1/range^2, 0 = infinite range
+    float inv_range2 = 0.0f; // 1/range^2, 0 = infinite range
     // Spot cone: smooth step from cos_outer to cos_inner, 1/max(cos_inner - cos_outer, 1e-4).
     // The defaults make the factor exactly 1 for any direction (point lights).
     float cos_outer = -2.0f;
@@ -44,8 +44,8 @@ struct LightLanes {
     float albedo[3][kLightLanes];
     float emissive[3][kLightLanes];
     float world[3][kLightLanes];
-    float normal[3][kLightLanes];  // any length; (0,0,0) means "use +z"
-    float rgb[3][kLightLanes];     // output
+    float normal[3][kLightLanes]; // any length; (0,0,0) means "use +z"
+    float rgb[3][kLightLanes];    // output
 };
 
 using LightKernel = void (*)(const PreparedLight* lights, uint32_t light_count,
@@ -55,7 +55,7 @@ using LightKernel = void (*)(const PreparedLight* lights, uint32_t light_count,
 void lightKernelScalar(const PreparedLight* lights, uint32_t light_count,
                        const LightMaterial& material, const float eye[3], LightLanes& io,
                        int lanes);
-LightKernel lightKernelAvx2();  // nullptr when not compiled in
+LightKernel lightKernelAvx2(); // nullptr when not compiled in
 LightKernel selectLightKernel(bool simd);
 
-}  // namespace raster
+} // namespace raster

@@ -10,15 +10,19 @@ constexpr float kPi = 3.14159265358979f;
 // Constant ambient light (fraction of the base colour) so surfaces facing away stay visible.
 constexpr float kAmbient = 0.12f;
 
-inline float asFloat(int32_t i) { return __builtin_bit_cast(float, i); }
-inline int32_t asInt(float f) { return __builtin_bit_cast(int32_t, f); }
+inline float asFloat(int32_t i) {
+    return __builtin_bit_cast(float, i);
+}
+inline int32_t asInt(float f) {
+    return __builtin_bit_cast(int32_t, f);
+}
 
 // log2(x) for normal x > 0: x = m 2^e with m in [sqrt(1/2), sqrt(2)), then
 // log2(m) = 2/ln2 * atanh(t), t = (m-1)/(m+1), |t| < 0.172: five odd terms give ~1e-8.
 inline float log2Positive(float x) {
     const int32_t bits = asInt(x);
     int32_t e = ((bits >> 23) & 0xff) - 127;
-    float m = asFloat((bits & 0x007fffff) | 0x3f800000);  // [1, 2)
+    float m = asFloat((bits & 0x007fffff) | 0x3f800000); // [1, 2)
     const bool high = m > 1.41421356f;
     m = high ? m * 0.5f : m;
     e = high ? e + 1 : e;
@@ -26,7 +30,7 @@ inline float log2Positive(float x) {
     const float t2 = t * t;
     const float series =
         t * (1.0f + t2 * (1.0f / 3.0f + t2 * (1.0f / 5.0f + t2 * (1.0f / 7.0f + t2 / 9.0f))));
-    return float(e) + series * 2.88539008f;  // 2/ln(2)
+    return float(e) + series * 2.88539008f; // 2/ln(2)
 }
 
 // 2^y for y <= 0: y = n + f with n = trunc(y) and f in (-1, 0]; 2^f by its Taylor series in
@@ -57,7 +61,7 @@ inline float powUnit(float x, float s) {
     return r * (x > 0.0f ? 1.0f : 0.0f);
 }
 
-}  // namespace
+} // namespace
 
 void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* lights, uint32_t light_count,
                              const LightMaterial& material, const float eye[3], LightLanes& io,
@@ -135,8 +139,8 @@ void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* lights, uint32_t light_count,
             const float cd = -(L.direction[0] * lx + L.direction[1] * ly + L.direction[2] * lz);
             const float tc = (cd - L.cos_outer) * L.inv_cone_width;
             const float cone = tc < 0.0f ? 0.0f : (tc > 1.0f ? 1.0f : tc);
-            const float attenuation = (1.0f / dist2) * (window < 0.0f ? 0.0f : window) *
-                                      (cone * cone);
+            const float attenuation =
+                (1.0f / dist2) * (window < 0.0f ? 0.0f : window) * (cone * cone);
             accumulate(L, l, lx, ly, lz, attenuation);
         }
     }

@@ -12,9 +12,11 @@ namespace {
 #define FOCAL_LIGHT_KERNEL_NAME lightKernelAvx2Impl
 #include "light_kernel.inl"
 #undef FOCAL_LIGHT_KERNEL_NAME
-}  // namespace
+} // namespace
 
-LightKernel lightKernelAvx2() { return &lightKernelAvx2Impl; }
+LightKernel lightKernelAvx2() {
+    return &lightKernelAvx2Impl;
+}
 
-}  // namespace raster
+} // namespace raster
 #endif

@@ -7,7 +7,9 @@ namespace raster {
 #undef FOCAL_QUAD_KERNEL_NAME
 
 #ifdef FOCAL_NO_SIMD
-QuadKernel quadKernelAvx2() { return nullptr; }
+QuadKernel quadKernelAvx2() {
+    return nullptr;
+}
 #endif
 
 QuadKernel selectQuadKernel(bool simd) {
@@ -20,4 +22,4 @@ QuadKernel selectQuadKernel(bool simd) {
     return &quadKernelScalar;
 }
 
-}  // namespace raster
+} // namespace raster

@@ -10,25 +10,25 @@
 
 namespace raster {
 
-constexpr int kQuadLanes = 8;  // two horizontally adjacent 2x2 quads; lane = quad*4 + dy*2 + dx
+constexpr int kQuadLanes = 8; // two horizontally adjacent 2x2 quads; lane = quad*4 + dy*2 + dx
 
 struct QuadInput {
-    double edge[3];    // edge function values at the first pixel centre (exact integers)
-    double step_x[3];  // change of each edge function per pixel in x
-    double step_y[3];  // per pixel in y
-    double bias[3];    // 0 or -1: the top-left rule
-    double inv_area2;  // 1 / (2 * area)
-    float inv_w[3];    // per vertex
-    float z[3];        // stored depth D per vertex
-    uint32_t valid;    // lanes inside the viewport
+    double edge[3];   // edge function values at the first pixel centre (exact integers)
+    double step_x[3]; // change of each edge function per pixel in x
+    double step_y[3]; // per pixel in y
+    double bias[3];   // 0 or -1: the top-left rule
+    double inv_area2; // 1 / (2 * area)
+    float inv_w[3];   // per vertex
+    float z[3];       // stored depth D per vertex
+    uint32_t valid;   // lanes inside the viewport
 };
 
 struct QuadOutput {
-    uint32_t mask;              // covered lanes
-    float lambda[3][kQuadLanes];  // screen-space barycentrics
-    float persp[3][kQuadLanes];   // perspective-correct barycentrics
-    float distance[kQuadLanes];   // view distance d = w
-    float z[kQuadLanes];          // stored depth D, clamped to [0, 1]
+    uint32_t mask;               // covered lanes
+    float lambda[3][kQuadLanes]; // screen-space barycentrics
+    float persp[3][kQuadLanes];  // perspective-correct barycentrics
+    float distance[kQuadLanes];  // view distance d = w
+    float z[kQuadLanes];         // stored depth D, clamped to [0, 1]
 };
 
 using QuadKernel = void (*)(const QuadInput&, QuadOutput&);
@@ -39,4 +39,4 @@ QuadKernel quadKernelAvx2();
 // The fastest kernel this CPU runs, or the scalar reference when `simd` is false.
 QuadKernel selectQuadKernel(bool simd);
 
-}  // namespace raster
+} // namespace raster

@@ -7,7 +7,6 @@
 #error "define FOCAL_QUAD_KERNEL_NAME before including quad_kernel.inl"
 #endif
 
-
 void FOCAL_QUAD_KERNEL_NAME(const QuadInput& in, QuadOutput& out) {
     constexpr int n = kQuadLanes;
     alignas(32) static constexpr double kDx[n] = {0, 1, 0, 1, 2, 3, 2, 3};

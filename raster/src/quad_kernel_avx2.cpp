@@ -12,9 +12,11 @@ namespace {
 #define FOCAL_QUAD_KERNEL_NAME quadKernelAvx2Impl
 #include "quad_kernel.inl"
 #undef FOCAL_QUAD_KERNEL_NAME
-}  // namespace
+} // namespace
 
-QuadKernel quadKernelAvx2() { return &quadKernelAvx2Impl; }
+QuadKernel quadKernelAvx2() {
+    return &quadKernelAvx2Impl;
+}
 
-}  // namespace raster
+} // namespace raster
 #endif

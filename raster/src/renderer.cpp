@@ -1,20 +1,18 @@
-#include <raster/renderer.h>
-
-#include <raster/surface_shading.h>
-
 #include "binning.h"
 #include "geometry.h"
 #include "light_kernel.h"
 #include "sinks.h"
 #include "tile_raster.h"
 
-#include <algorithm>
+#include <raster/renderer.h>
+#include <raster/surface_shading.h>
 
+#include <glm/geometric.hpp>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
-
-#include <glm/geometric.hpp>
 
 namespace raster {
 
@@ -69,7 +67,7 @@ double msSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
 }
-}  // namespace
+} // namespace
 
 Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptions& options,
                          FrameStats* stats) {
@@ -156,7 +154,7 @@ Status validate(const LayeredTargetDesc& desc) {
     return {};
 }
 
-}  // namespace
+} // namespace
 
 Status Renderer::render(const Scene& scene, const View& view, const RenderOptions& options,
                         Frame& out, FrameStats* stats) {
@@ -355,4 +353,4 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     return {};
 }
 
-}  // namespace raster
+} // namespace raster

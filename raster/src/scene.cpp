@@ -32,10 +32,10 @@ uint64_t triangleCount(const Scene& scene) {
 }
 
 const Material& materialOf(const Scene& scene, const Primitive& primitive) {
-    static const Material kDefault{};  // glTF 2.0 §3.9.7: the default material
+    static const Material kDefault{}; // glTF 2.0 §3.9.7: the default material
     if (primitive.material < 0 || size_t(primitive.material) >= scene.materials.size())
         return kDefault;
     return scene.materials[size_t(primitive.material)];
 }
 
-}  // namespace raster
+} // namespace raster

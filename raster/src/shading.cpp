@@ -1,11 +1,11 @@
 #include "shading.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <glm/exponential.hpp>
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 namespace raster {
 
@@ -28,7 +28,7 @@ glm::vec4 sampleRef(const ShadeContext& ctx, const TextureRef& ref, const UvFoot
     return sampleImage(image, sampler, ctx.filter, uv, lod);
 }
 
-}  // namespace
+} // namespace
 
 glm::vec4 baseColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
                     glm::vec4 vertex_color) {
@@ -77,4 +77,4 @@ glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world
     return {lanes.rgb[0][0], lanes.rgb[1][0], lanes.rgb[2][0]};
 }
 
-}  // namespace raster
+} // namespace raster

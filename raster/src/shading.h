@@ -22,7 +22,7 @@ struct ShadeContext {
     glm::vec3 eye{0.0f};
     ShadingMode mode = ShadingMode::Material;
     FilterOverride filter = FilterOverride::Sampler;
-    const PreparedLight* lights = nullptr;  // prepareLights(): the scene's or the default light
+    const PreparedLight* lights = nullptr; // prepareLights(): the scene's or the default light
     uint32_t light_count = 0;
     LightKernel light_kernel = &lightKernelScalar;
 };
@@ -52,4 +52,4 @@ GSample surfaceSample(const ShadeContext& ctx, const Material& m, const UvFootpr
 // Shades a G-buffer sample at `world` as seen from `eye` (the same lighting kernel as fragments).
 glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world, glm::vec3 eye);
 
-}  // namespace raster
+} // namespace raster

@@ -26,7 +26,7 @@ inline glm::vec4 blendOver(glm::vec4 src, glm::vec4 dst) {
 
 struct FrameSink {
     Frame& frame;
-    const DepthBuffer* peel = nullptr;  // depth peeling: keep only fragments behind this
+    const DepthBuffer* peel = nullptr; // depth peeling: keep only fragments behind this
     static constexpr bool wants_gbuffer = false;
 
     void beginTriangle(const SetupTri&) {}
@@ -46,9 +46,9 @@ struct FrameSink {
 
 struct LayerSink {
     LayeredTarget& target;
-    const std::vector<LayerInterval>& intervals;  // overlapped, one per layer
+    const std::vector<LayerInterval>& intervals; // overlapped, one per layer
     bool wants_gbuffer = false;
-    uint32_t triangle_layer = 0;  // MaxVertexDepth routing: the current triangle's layer
+    uint32_t triangle_layer = 0; // MaxVertexDepth routing: the current triangle's layer
 
     void beginTriangle(const SetupTri& t) {
         if (target.desc.routing == LayerRouting::MaxVertexDepth)
@@ -93,10 +93,10 @@ struct LayerSink {
 
 // One collected fragment: a node of a per-pixel linked list.
 struct FragmentNode {
-    glm::vec4 color;  // RGB + opacity, full precision until the resolve stores the chosen format
+    glm::vec4 color; // RGB + opacity, full precision until the resolve stores the chosen format
     float z;
     uint32_t primitive_id;
-    uint32_t next;  // index of the next node in this tile's pool, kNoNode at the tail
+    uint32_t next; // index of the next node in this tile's pool, kNoNode at the tail
 };
 constexpr uint32_t kNoNode = 0xffffffffu;
 
@@ -104,15 +104,15 @@ constexpr uint32_t kNoNode = 0xffffffffu;
 // the GPU does); pools are concatenated in tile order afterwards, so node order is deterministic.
 struct ListSink {
     std::vector<uint32_t>& head;     // per pixel: first node (tile-local index) or kNoNode
-    std::vector<FragmentNode>& pool;  // this tile's nodes
+    std::vector<FragmentNode>& pool; // this tile's nodes
     static constexpr bool wants_gbuffer = false;
 
     void beginTriangle(const SetupTri&) {}
-    bool test(size_t, float, float) const { return true; }  // every fragment is collected
+    bool test(size_t, float, float) const { return true; } // every fragment is collected
     void write(size_t pixel, const Fragment& f) {
         pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
         head[pixel] = uint32_t(pool.size() - 1);
     }
 };
 
-}  // namespace raster
+} // namespace raster

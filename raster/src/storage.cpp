@@ -31,4 +31,4 @@ void ColorBuffer::resize(ColorFormat color_format, size_t pixels, glm::vec4 clea
     }
 }
 
-}  // namespace raster
+} // namespace raster

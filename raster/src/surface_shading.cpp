@@ -1,11 +1,11 @@
-#include <raster/surface_shading.h>
-
 #include "light_kernel.h"
 #include "shading.h"
 
-#include <vector>
+#include <raster/surface_shading.h>
 
 #include <glm/geometric.hpp>
+
+#include <vector>
 
 namespace raster {
 
@@ -35,4 +35,4 @@ glm::vec3 SurfaceShader::shade(const GSample& g, glm::vec3 world, glm::vec3 eye)
     return shadeSample(impl_->ctx, g, world, eye);
 }
 
-}  // namespace raster
+} // namespace raster

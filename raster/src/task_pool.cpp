@@ -70,4 +70,4 @@ void TaskPool::parallelFor(uint32_t count, const std::function<void(uint32_t, ui
     job_ = nullptr;
 }
 
-}  // namespace raster
+} // namespace raster

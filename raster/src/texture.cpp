@@ -1,10 +1,10 @@
 #include <raster/texture.h>
 
+#include <glm/common.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
-
-#include <glm/common.hpp>
 
 namespace raster {
 
@@ -47,7 +47,7 @@ glm::vec4 fetch(const MipLevel& level, bool srgb, int x, int y) {
 }
 
 int wrapIndex(int64_t i, int n, Wrap wrap) {
-    if (i >= 0 && i < n)  // inside: every mode agrees, and it is by far the common case
+    if (i >= 0 && i < n) // inside: every mode agrees, and it is by far the common case
         return int(i);
     switch (wrap) {
     case Wrap::Repeat:
@@ -80,14 +80,16 @@ glm::vec4 sampleLevel(const Image& image, const MipLevel& level, const Sampler& 
     }
     const double fx = std::floor(x), fy = std::floor(y);
     const float ax = float(x - fx), ay = float(y - fy);
-    const int x0 = wrapIndex(int64_t(fx), w, s.wrap_s), x1 = wrapIndex(int64_t(fx) + 1, w, s.wrap_s);
-    const int y0 = wrapIndex(int64_t(fy), h, s.wrap_t), y1 = wrapIndex(int64_t(fy) + 1, h, s.wrap_t);
+    const int x0 = wrapIndex(int64_t(fx), w, s.wrap_s),
+              x1 = wrapIndex(int64_t(fx) + 1, w, s.wrap_s);
+    const int y0 = wrapIndex(int64_t(fy), h, s.wrap_t),
+              y1 = wrapIndex(int64_t(fy) + 1, h, s.wrap_t);
     const glm::vec4 top = glm::mix(fetch(level, lut, x0, y0), fetch(level, lut, x1, y0), ax);
     const glm::vec4 bottom = glm::mix(fetch(level, lut, x0, y1), fetch(level, lut, x1, y1), ax);
     return glm::mix(top, bottom, ay);
 }
 
-}  // namespace
+} // namespace
 
 void buildMipChain(Image& image) {
     if (image.levels.empty())
@@ -155,4 +157,4 @@ glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride
     return glm::mix(a, b, l - float(l0));
 }
 
-}  // namespace raster
+} // namespace raster

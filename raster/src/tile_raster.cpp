@@ -3,18 +3,20 @@
 #include "quad_kernel.h"
 #include "sinks.h"
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
-
-#include <glm/geometric.hpp>
 
 namespace raster {
 
 namespace {
 
-constexpr int32_t kBlockSize = 8;  // hierarchical test: tile -> 8x8 block -> 2x2 quad -> pixel
+constexpr int32_t kBlockSize = 8; // hierarchical test: tile -> 8x8 block -> 2x2 quad -> pixel
 
-int64_t centre(int64_t i) { return i * kSubpixelOne + kSubpixelOne / 2; }
+int64_t centre(int64_t i) {
+    return i * kSubpixelOne + kSubpixelOne / 2;
+}
 
 // Per-triangle constants for the pixel loop.
 struct TriangleRaster {
@@ -23,9 +25,9 @@ struct TriangleRaster {
     const Material* material;
     Edge edges[3];
     double inv_area2;
-    glm::vec3 face_normal;  // faces the eye; used when the primitive has no normals
+    glm::vec3 face_normal; // faces the eye; used when the primitive has no normals
     bool has_normals;
-    bool has_colors;  // without vertex colours the colour is exactly white
+    bool has_colors; // without vertex colours the colour is exactly white
 };
 
 glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
@@ -108,7 +110,7 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         if (tr.has_normals) {
             normal = b[0] * tr.v[0]->normal + b[1] * tr.v[1]->normal + b[2] * tr.v[2]->normal;
             if (!t.front_facing)
-                normal = -normal;  // glTF: back faces of double-sided materials flip the normal
+                normal = -normal; // glTF: back faces of double-sided materials flip the normal
         }
         const glm::vec3 emissive = emissiveColor(ctx.shade, m, lane_uv[l]);
         for (int c = 0; c < 3; ++c) {
@@ -192,7 +194,7 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     }
 }
 
-}  // namespace
+} // namespace
 
 template <class Sink>
 void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters) {
@@ -215,4 +217,4 @@ template void rasterizeTile<FrameSink>(const RasterContext&, uint32_t, FrameSink
 template void rasterizeTile<LayerSink>(const RasterContext&, uint32_t, LayerSink&, TileCounters&);
 template void rasterizeTile<ListSink>(const RasterContext&, uint32_t, ListSink&, TileCounters&);
 
-}  // namespace raster
+} // namespace raster

@@ -26,18 +26,18 @@ struct RasterContext {
 };
 
 struct TileCounters {
-    uint64_t covered = 0;  // samples inside a triangle
-    uint64_t passed = 0;   // of those, passed the sink's test and the alpha test
+    uint64_t covered = 0; // samples inside a triangle
+    uint64_t passed = 0;  // of those, passed the sink's test and the alpha test
 };
 
 // A shaded fragment as the output merger sees it.
 struct Fragment {
-    float z = 1.0f;         // stored depth D (camera.h)
-    float distance = 0.0f;  // view distance d
-    glm::vec4 color{0.0f};  // linear RGB and opacity (1 for OPAQUE and MASK)
-    bool blend = false;     // BLEND material: composite with "over", no depth write
+    float z = 1.0f;        // stored depth D (camera.h)
+    float distance = 0.0f; // view distance d
+    glm::vec4 color{0.0f}; // linear RGB and opacity (1 for OPAQUE and MASK)
+    bool blend = false;    // BLEND material: composite with "over", no depth write
     uint32_t primitive_id = 0;
-    GSample g;  // filled only when the sink asks for it
+    GSample g; // filled only when the sink asks for it
 };
 
 // Rasterizes every triangle binned to `tile` and hands the fragments to `sink`.
@@ -46,4 +46,4 @@ struct Fragment {
 template <class Sink>
 void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters);
 
-}  // namespace raster
+} // namespace raster

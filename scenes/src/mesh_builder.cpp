@@ -51,7 +51,6 @@ float fraction(uint32_t i, uint32_t n) {
 
 } // namespace
 
-
 float hashUnit(uint32_t key, uint32_t stream) {
     const uint32_t h = hash32(key ^ hash32(stream + 0x9e3779b9U));
     return static_cast<float>(h >> 8) * (1.0f / 16777216.0f);

@@ -78,4 +78,4 @@ glm::vec4 pixel(const raster::Frame& frame, uint32_t x, uint32_t y) {
     return {p[0], p[1], p[2], p[3]};
 }
 
-}  // namespace focal::test
+} // namespace focal::test

@@ -6,13 +6,13 @@
 #include <raster/renderer.h>
 #include <raster/scene.h>
 
-#include <cstdint>
-#include <string>
-#include <vector>
-
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
 
 namespace focal::test {
 
@@ -42,4 +42,4 @@ uint64_t hashFrame(const raster::Frame& frame);
 
 glm::vec4 pixel(const raster::Frame& frame, uint32_t x, uint32_t y);
 
-}  // namespace focal::test
+} // namespace focal::test

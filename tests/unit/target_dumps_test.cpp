@@ -6,11 +6,11 @@
 #include <raster/task_pool.h>
 #include <scenes/builtin.h>
 
-#include <filesystem>
-#include <fstream>
-
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
 
 namespace focal::test {
 namespace {
@@ -18,10 +18,10 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path freshDir(const char* name) {
-    const fs::path dir = fs::temp_directory_path() / ("focal_dump_" + std::string(name) + "_" +
-                                                      std::to_string(::getpid()));
+    const fs::path dir = fs::temp_directory_path() /
+                         ("focal_dump_" + std::string(name) + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
-    return dir / "nested";  // not created yet: the dump creates it
+    return dir / "nested"; // not created yet: the dump creates it
 }
 
 TEST(TargetDumps, UniformInverseDepthBounds) {
@@ -80,5 +80,5 @@ TEST(TargetDumps, LayersAndFragmentsOfTheRailing) {
     fs::remove_all(fdir.parent_path());
 }
 
-}  // namespace
-}  // namespace focal::test
+} // namespace
+} // namespace focal::test

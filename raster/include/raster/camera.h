@@ -9,31 +9,31 @@
 
 #include <raster/scene.h>
 
-#include <cstdint>
-
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+
+#include <cstdint>
 
 namespace raster {
 
 struct View {
     glm::vec3 eye{0.0f};
-    glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit view axis
-    glm::vec3 right{1.0f, 0.0f, 0.0f};     // unit, image +x
-    glm::vec3 up{0.0f, 1.0f, 0.0f};        // unit, image -y (pixel rows grow downwards)
-    float yfov = 0.8f;                     // vertical field of view, radians
+    glm::vec3 forward{0.0f, 0.0f, -1.0f}; // unit view axis
+    glm::vec3 right{1.0f, 0.0f, 0.0f};    // unit, image +x
+    glm::vec3 up{0.0f, 1.0f, 0.0f};       // unit, image -y (pixel rows grow downwards)
+    float yfov = 0.8f;                    // vertical field of view, radians
     uint32_t width = 800;
     uint32_t height = 600;
     float znear = 0.1f;
-    float zfar = 0.0f;  // 0: infinite far plane
+    float zfar = 0.0f; // 0: infinite far plane
 
     // Off-axis shifts for the accumulation reference (Haeberli & Akeley 1990): the eye moves by
     // lens_offset (world units along right/up) while the frustum is sheared so that the plane at
     // focus_distance keeps its pixels; pixel_shift moves the image by a sub-pixel amount.
     glm::vec2 lens_offset{0.0f};
     float focus_distance = 1.0f;
-    glm::vec2 pixel_shift{0.0f};  // pixels, +x right, +y down
+    glm::vec2 pixel_shift{0.0f}; // pixels, +x right, +y down
 };
 
 // Focal length in pixels: f_px = (H/2) / tan(yfov/2).
@@ -57,4 +57,4 @@ View viewFramingBounds(const Bounds& bounds, uint32_t width, uint32_t height);
 View viewLookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float yfov, uint32_t width,
                 uint32_t height, float znear, float zfar);
 
-}  // namespace raster
+} // namespace raster

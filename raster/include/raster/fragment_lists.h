@@ -16,15 +16,15 @@
 namespace raster {
 
 enum class OverflowPolicy : uint8_t {
-    Grow,  // re-render once with a node pool exactly as large as needed (reported in stats)
-    Fail,  // return an error naming the capacity and the count needed
+    Grow, // re-render once with a node pool exactly as large as needed (reported in stats)
+    Fail, // return an error naming the capacity and the count needed
 };
 
 struct FragmentListDesc {
-    uint32_t node_capacity = 1u << 22;  // nodes in the pool (fragments before the N cap)
-    uint32_t max_per_pixel = 4;         // closest N kept by the resolve; 0 keeps all
-    ColorFormat color_format = ColorFormat::Half;    // Selgrad et al.: half colour and opacity
-    DepthFormat depth_format = DepthFormat::Float32;  // and single-precision depth
+    uint32_t node_capacity = 1u << 22;            // nodes in the pool (fragments before the N cap)
+    uint32_t max_per_pixel = 4;                   // closest N kept by the resolve; 0 keeps all
+    ColorFormat color_format = ColorFormat::Half; // Selgrad et al.: half colour and opacity
+    DepthFormat depth_format = DepthFormat::Float32; // and single-precision depth
     OverflowPolicy on_overflow = OverflowPolicy::Grow;
 };
 
@@ -34,17 +34,17 @@ struct FragmentLists {
     FragmentListDesc desc;
     // Compacted, sorted lists: pixel i owns fragments [offsets[i], offsets[i+1]).
     std::vector<uint32_t> offsets;
-    ColorBuffer color;     // linear RGB + opacity (alpha), one per fragment
-    DepthBuffer depth;     // stored depth D, one per fragment (width = count, height = 1)
-    std::vector<uint32_t> primitive;  // submission index of the fragment's triangle
-    std::vector<uint32_t> list_length;  // per pixel: fragments collected before the cap
+    ColorBuffer color;               // linear RGB + opacity (alpha), one per fragment
+    DepthBuffer depth;               // stored depth D, one per fragment (width = count, height = 1)
+    std::vector<uint32_t> primitive; // submission index of the fragment's triangle
+    std::vector<uint32_t> list_length; // per pixel: fragments collected before the cap
 
     // Counts from the collection pass.
-    uint64_t fragments_collected = 0;  // nodes appended (all fragments)
-    uint64_t fragments_kept = 0;       // after the closest-N cap
-    uint32_t max_list_length = 0;      // longest list before the cap
-    uint32_t node_capacity_used = 0;   // capacity of the pool that succeeded
-    bool grew = false;                 // the pool overflowed once and was grown
+    uint64_t fragments_collected = 0; // nodes appended (all fragments)
+    uint64_t fragments_kept = 0;      // after the closest-N cap
+    uint32_t max_list_length = 0;     // longest list before the cap
+    uint32_t node_capacity_used = 0;  // capacity of the pool that succeeded
+    bool grew = false;                // the pool overflowed once and was grown
 
     uint32_t count(size_t pixel) const { return offsets[pixel + 1] - offsets[pixel]; }
     size_t bytes() const {
@@ -53,4 +53,4 @@ struct FragmentLists {
     }
 };
 
-}  // namespace raster
+} // namespace raster

@@ -12,8 +12,8 @@ namespace raster {
 struct Frame {
     uint32_t width = 0;
     uint32_t height = 0;
-    std::vector<float> color;  // linear RGBA, 4 floats per pixel
+    std::vector<float> color; // linear RGBA, 4 floats per pixel
     DepthBuffer depth;
 };
 
-}  // namespace raster
+} // namespace raster

@@ -13,4 +13,4 @@ namespace raster {
 // Scene::warnings; an unsupported required extension is an error.
 Result<Scene> importGltf(const std::string& path);
 
-}  // namespace raster
+} // namespace raster

@@ -17,4 +17,4 @@ constexpr uint32_t hash32(uint32_t x) {
     return x;
 }
 
-}  // namespace raster
+} // namespace raster

@@ -6,10 +6,10 @@
 
 #include <raster/storage.h>
 
+#include <glm/vec3.hpp>
+
 #include <cstdint>
 #include <vector>
-
-#include <glm/vec3.hpp>
 
 namespace raster {
 
@@ -33,17 +33,17 @@ struct LayeredTargetDesc {
     LayerRouting routing = LayerRouting::MaxVertexDepth;
     ColorFormat color_format = ColorFormat::Float32;
     DepthFormat depth_format = DepthFormat::Float32;
-    bool gbuffer = false;  // also store normals and material parameters (Lee et al. §5)
+    bool gbuffer = false; // also store normals and material parameters (Lee et al. §5)
 };
 
 // One G-buffer texel: the surface a layer pixel shows, for shading it from another direction.
 struct GSample {
-    glm::vec3 normal{0.0f};  // world space, unit, facing the centre view
+    glm::vec3 normal{0.0f}; // world space, unit, facing the centre view
     float metallic = 0.0f;
-    glm::vec3 base_color{0.0f};  // linear albedo (texture x factor x vertex colour)
+    glm::vec3 base_color{0.0f}; // linear albedo (texture x factor x vertex colour)
     float roughness = 1.0f;
     glm::vec3 emissive{0.0f};
-    float unlit = 0.0f;  // 1: the colour does not depend on the view
+    float unlit = 0.0f; // 1: the colour does not depend on the view
 };
 
 struct LayeredTarget {
@@ -74,4 +74,4 @@ LayerInterval overlappedInterval(const LayeredTargetDesc& desc, uint32_t layer);
 // The layer whose (non-overlapped) interval holds distance d, clamped to [0, M-1].
 uint32_t layerOf(const LayeredTargetDesc& desc, float d);
 
-}  // namespace raster
+} // namespace raster

@@ -19,13 +19,13 @@
 namespace raster {
 
 enum class ShadingMode : uint8_t {
-    Material,  // lit, except materials with KHR_materials_unlit
-    Unlit,     // base colour x texture x vertex colour (+ emissive)
-    Lit,       // Lambert + Blinn-Phong for every material
+    Material, // lit, except materials with KHR_materials_unlit
+    Unlit,    // base colour x texture x vertex colour (+ emissive)
+    Lit,      // Lambert + Blinn-Phong for every material
 };
 
 struct RenderOptions {
-    uint32_t tile_size = 64;  // pixels, a multiple of 8 in [8, 256]
+    uint32_t tile_size = 64; // pixels, a multiple of 8 in [8, 256]
     DepthFormat depth_format = DepthFormat::Float32;
     ShadingMode shading = ShadingMode::Material;
     FilterOverride texture_filter = FilterOverride::Sampler;
@@ -39,17 +39,17 @@ struct RenderOptions {
 
 // Counts and stage times of one render. Counts are deterministic; times are not.
 struct FrameStats {
-    uint64_t triangles_in = 0;       // triangles submitted
-    uint64_t triangles_culled = 0;   // back-facing, zero-area, or outside the frustum
-    uint64_t triangles_clipped = 0;  // cut by the near/far planes or beyond the guard band
-    uint64_t triangles_setup = 0;    // triangles that reached binning (after clipping)
-    uint64_t fragments_covered = 0;  // samples inside a triangle
-    uint64_t fragments_passed = 0;   // of those, passed alpha and depth tests
+    uint64_t triangles_in = 0;      // triangles submitted
+    uint64_t triangles_culled = 0;  // back-facing, zero-area, or outside the frustum
+    uint64_t triangles_clipped = 0; // cut by the near/far planes or beyond the guard band
+    uint64_t triangles_setup = 0;   // triangles that reached binning (after clipping)
+    uint64_t fragments_covered = 0; // samples inside a triangle
+    uint64_t fragments_passed = 0;  // of those, passed alpha and depth tests
     double ms_geometry = 0.0;
     double ms_binning = 0.0;
     double ms_raster = 0.0;
-    double ms_resolve = 0.0;  // layers: fragment-copy pass; lists: sort, cap and compact
-    uint64_t target_bytes = 0;  // memory held by the render target's buffers
+    double ms_resolve = 0.0;   // layers: fragment-copy pass; lists: sort, cap and compact
+    uint64_t target_bytes = 0; // memory held by the render target's buffers
 };
 
 class Renderer {
@@ -94,4 +94,4 @@ constexpr uint32_t kMaxLayers = 64;
 Status validate(const RenderOptions& options);
 Status validate(const View& view);
 
-}  // namespace raster
+} // namespace raster

@@ -29,8 +29,8 @@ private:
 // Holds a value or the Status explaining why there is none.
 template <class T> class [[nodiscard]] Result {
 public:
-    Result(T value) : value_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
-    Result(Status status) : status_(std::move(status)) {}  // NOLINT(google-explicit-constructor)
+    Result(T value) : value_(std::move(value)) {}         // NOLINT(google-explicit-constructor)
+    Result(Status status) : status_(std::move(status)) {} // NOLINT(google-explicit-constructor)
     bool ok() const { return value_.has_value(); }
     const Status& status() const { return status_; }
     T& value() { return *value_; }
@@ -45,4 +45,4 @@ private:
     Status status_;
 };
 
-}  // namespace raster
+} // namespace raster

@@ -3,12 +3,12 @@
 // Buffers are plain arrays owned by the target that holds them.
 #pragma once
 
+#include <Imath/half.h>
+#include <glm/vec4.hpp>
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
-
-#include <Imath/half.h>
-#include <glm/vec4.hpp>
 
 namespace raster {
 
@@ -27,8 +27,8 @@ struct DepthBuffer {
     DepthFormat format = DepthFormat::Float32;
     uint32_t width = 0;
     uint32_t height = 0;
-    std::vector<uint16_t> unorm16;  // used when format == Unorm16
-    std::vector<float> float32;     // used when format == Float32
+    std::vector<uint16_t> unorm16; // used when format == Unorm16
+    std::vector<float> float32;    // used when format == Float32
 
     // Resizes and clears to the far value (D = 1).
     void resize(DepthFormat depth_format, uint32_t w, uint32_t h);
@@ -51,8 +51,8 @@ struct DepthBuffer {
 
 struct ColorBuffer {
     ColorFormat format = ColorFormat::Float32;
-    std::vector<Imath::half> half;  // 4 per pixel, used when format == Half
-    std::vector<float> float32;     // 4 per pixel, used when format == Float32
+    std::vector<Imath::half> half; // 4 per pixel, used when format == Half
+    std::vector<float> float32;    // 4 per pixel, used when format == Float32
 
     // Resizes to `pixels` RGBA values, all set to `clear`.
     void resize(ColorFormat color_format, size_t pixels, glm::vec4 clear);
@@ -74,4 +74,4 @@ struct ColorBuffer {
     size_t bytes() const { return half.size() * 2 + float32.size() * 4; }
 };
 
-}  // namespace raster
+} // namespace raster

@@ -8,9 +8,9 @@
 #include <raster/layered_target.h>
 #include <raster/scene.h>
 
-#include <memory>
-
 #include <glm/vec3.hpp>
+
+#include <memory>
 
 namespace raster {
 
@@ -35,4 +35,4 @@ private:
 // The direction of travel of the default light for `view` (from above-left, behind the viewer).
 glm::vec3 defaultLightDirection(const View& view);
 
-}  // namespace raster
+} // namespace raster

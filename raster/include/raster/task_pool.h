@@ -47,4 +47,4 @@ private:
     std::atomic<uint32_t> next_{0};
 };
 
-}  // namespace raster
+} // namespace raster

@@ -4,12 +4,12 @@
 // *before* filtering (a 256-entry table), and mip levels are box-filtered in linear space.
 #pragma once
 
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <glm/vec2.hpp>
-#include <glm/vec4.hpp>
 
 namespace raster {
 
@@ -29,13 +29,13 @@ struct Sampler {
 struct MipLevel {
     uint32_t width = 0;
     uint32_t height = 0;
-    std::vector<uint8_t> rgba8;  // width*height*4, row 0 is the top row (glTF uv (0,0))
+    std::vector<uint8_t> rgba8; // width*height*4, row 0 is the top row (glTF uv (0,0))
 };
 
 struct Image {
     std::string name;
-    bool srgb = true;              // colour channels sRGB-encoded (base colour, emissive)
-    std::vector<MipLevel> levels;  // levels[0] is the full image; buildMipChain adds the rest
+    bool srgb = true;             // colour channels sRGB-encoded (base colour, emissive)
+    std::vector<MipLevel> levels; // levels[0] is the full image; buildMipChain adds the rest
 };
 
 // Replaces image.levels[1..] with the full chain down to 1x1: each texel of level i+1 is the
@@ -54,4 +54,4 @@ glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride
 float srgbToLinear(float v);
 float linearToSrgb(float v);
 
-}  // namespace raster
+} // namespace raster

@@ -1,10 +1,10 @@
 // Coverage: fill rule, watertightness, clipping, guard band and culling (issue 3).
 #include "support/test_util.h"
 
-#include <cmath>
-
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace focal::test {
 namespace {
@@ -12,10 +12,12 @@ namespace {
 using raster::AlphaMode;
 
 constexpr uint32_t kSize = 64;
-constexpr float kDist = 64.0f;  // the plane where one world unit is one pixel
+constexpr float kDist = 64.0f; // the plane where one world unit is one pixel
 
 // World point on the pixel-exact plane for pixel coordinates (px, py).
-glm::vec3 at(float px, float py) { return {px - 32.0f, 32.0f - py, -kDist}; }
+glm::vec3 at(float px, float py) {
+    return {px - 32.0f, 32.0f - py, -kDist};
+}
 
 // Every triangle is drawn with 50% white over black: a pixel covered once reads 0.5, twice 0.75.
 raster::Scene blendScene() {
@@ -39,8 +41,8 @@ TEST(Coverage, TopLeftRuleOnPixelCentres) {
     // A square whose corners are pixel centres (2.5,2.5)-(6.5,6.5): the top and left edges own
     // the centres on them, the bottom and right edges do not, so exactly 4x4 pixels are covered.
     raster::Scene s = blendScene();
-    addMesh(s, {at(2.5f, 2.5f), at(6.5f, 2.5f), at(6.5f, 6.5f), at(2.5f, 6.5f)},
-            {0, 3, 2, 0, 2, 1}, 0);
+    addMesh(s, {at(2.5f, 2.5f), at(6.5f, 2.5f), at(6.5f, 6.5f), at(2.5f, 6.5f)}, {0, 3, 2, 0, 2, 1},
+            0);
     const raster::Frame f = render(s, pixelView(kSize, kSize, kDist));
     for (uint32_t y = 0; y < 10; ++y)
         for (uint32_t x = 0; x < 10; ++x) {
@@ -160,7 +162,7 @@ TEST(Coverage, ZeroAreaAndSliverTriangles) {
 
 struct CullCase {
     const char* name;
-    bool clockwise;  // as seen from the camera
+    bool clockwise; // as seen from the camera
     bool double_sided;
     bool mirrored;
     bool visible;
@@ -173,8 +175,8 @@ TEST_P(Culling, HonoursWindingDoubleSidedAndMirroring) {
     raster::Scene s;
     addMaterial(s, flatMaterial(glm::vec4(1.0f), AlphaMode::Opaque, c.double_sided));
     // Counter-clockwise as seen from the camera is glTF's front face.
-    std::vector<uint32_t> idx = c.clockwise ? std::vector<uint32_t>{0, 2, 1}
-                                            : std::vector<uint32_t>{0, 1, 2};
+    std::vector<uint32_t> idx =
+        c.clockwise ? std::vector<uint32_t>{0, 2, 1} : std::vector<uint32_t>{0, 1, 2};
     const glm::mat4 world =
         c.mirrored ? glm::scale(glm::mat4(1.0f), glm::vec3(-1.0f, 1.0f, 1.0f)) : glm::mat4(1.0f);
     addMesh(s, {at(10, 50), at(50, 50), at(30, 10)}, idx, 0, world);
@@ -193,5 +195,5 @@ INSTANTIATE_TEST_SUITE_P(
                       CullCase{"back_mirrored", true, false, true, false}),
     [](const auto& test) { return std::string(test.param.name); });
 
-}  // namespace
-}  // namespace focal::test
+} // namespace
+} // namespace focal::test

@@ -1,13 +1,13 @@
 // The lighting kernel computes the documented model (docs/raster.md §5) to float accuracy,
 // with focal's own exp2/log2 standing in for std::pow.
-#include <raster/scene.h>
+#include "raster/src/light_kernel.h"
 
-#include <cmath>
+#include <raster/scene.h>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "raster/src/light_kernel.h"
+#include <cmath>
 
 namespace focal::test {
 namespace {
@@ -60,10 +60,10 @@ TEST(Lighting, KernelMatchesTheModel) {
             io.normal[c][0] = 2.0f * unit() - 1.0f;
         }
         raster::lightKernelScalar(lights.data(), uint32_t(lights.size()), m, eye, io, 1);
-        const glm::dvec3 e = reference(
-            scene.lights, {io.albedo[0][0], io.albedo[1][0], io.albedo[2][0]}, m.metallic,
-            m.roughness, {io.normal[0][0], io.normal[1][0], io.normal[2][0]},
-            {io.world[0][0], io.world[1][0], io.world[2][0]}, {eye[0], eye[1], eye[2]});
+        const glm::dvec3 e =
+            reference(scene.lights, {io.albedo[0][0], io.albedo[1][0], io.albedo[2][0]}, m.metallic,
+                      m.roughness, {io.normal[0][0], io.normal[1][0], io.normal[2][0]},
+                      {io.world[0][0], io.world[1][0], io.world[2][0]}, {eye[0], eye[1], eye[2]});
         for (int c = 0; c < 3; ++c)
             ASSERT_NEAR(io.rgb[c][0], e[c], 2e-4 * std::abs(e[c]) + 1e-5)
                 << i << " c " << c << " m " << m.metallic << "," << m.roughness << " n "
@@ -73,5 +73,5 @@ TEST(Lighting, KernelMatchesTheModel) {
     }
 }
 
-}  // namespace
-}  // namespace focal::test
+} // namespace
+} // namespace focal::test

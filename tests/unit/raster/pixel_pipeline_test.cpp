@@ -3,9 +3,9 @@
 
 #include <raster/camera.h>
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace focal::test {
 namespace {
@@ -17,8 +17,8 @@ constexpr uint32_t kSize = 64;
 constexpr float kDist = 64.0f;
 
 std::vector<glm::vec3> quadAt(float depth, float half) {
-    return {{-half, -half, -depth}, {half, -half, -depth}, {half, half, -depth},
-            {-half, half, -depth}};
+    return {
+        {-half, -half, -depth}, {half, -half, -depth}, {half, half, -depth}, {-half, half, -depth}};
 }
 const std::vector<uint32_t> kQuad = {0, 1, 2, 0, 2, 3};
 
@@ -62,7 +62,7 @@ TEST(Depth, StoredValuesMatchTheProjection) {
         EXPECT_NEAR(stored, expected, tolerance);
         EXPECT_NEAR(raster::distanceFromDepth(v, stored), 100.0f,
                     format == DepthFormat::Float32 ? 1e-3f : 0.2f);
-        EXPECT_EQ(f.depth.load(0), 1.0f);  // background keeps the clear value
+        EXPECT_EQ(f.depth.load(0), 1.0f); // background keeps the clear value
     }
 }
 
@@ -72,15 +72,15 @@ TEST(Interpolation, IsPerspectiveCorrect) {
     raster::Scene s;
     raster::Material m = flatMaterial({1, 1, 1, 1});
     const int32_t mat = addMaterial(s, m);
-    raster::Primitive& p = addMesh(s, {{-8, -1, -2}, {8, -1, -2}, {8, -1, -20}, {-8, -1, -20}},
-                                   kQuad, mat);
+    raster::Primitive& p =
+        addMesh(s, {{-8, -1, -2}, {8, -1, -2}, {8, -1, -20}, {-8, -1, -20}}, kQuad, mat);
     p.colors = {{0, 0, 0, 1}, {0, 0, 0, 1}, {1, 0, 0, 1}, {1, 0, 0, 1}};
     const raster::View v = pixelView(kSize, kSize, kDist);
     const raster::Frame f = render(s, v);
     const float fpx = raster::focalLengthPx(v);
     int checked = 0;
     for (uint32_t y = 33; y < kSize; ++y) {
-        const float ray_y = (32.0f - (float(y) + 0.5f)) / fpx;  // y/d along the centre ray
+        const float ray_y = (32.0f - (float(y) + 0.5f)) / fpx; // y/d along the centre ray
         const float d = -1.0f / ray_y;
         if (d < 2.05f || d > 19.95f)
             continue;
@@ -101,8 +101,8 @@ TEST(Alpha, MaskDiscardsBelowTheCutoffAndIsOpaqueAbove) {
     raster::Primitive& p = addMesh(s, quadAt(kDist, 32.0f), kQuad, mat);
     p.colors = {{1, 1, 1, 0}, {1, 1, 1, 1}, {1, 1, 1, 1}, {1, 1, 1, 0}};
     const raster::Frame f = render(s, pixelView(kSize, kSize, kDist));
-    EXPECT_EQ(pixel(f, 10, 32), glm::vec4(0, 0, 0, 1));  // alpha ~0.16: discarded
-    EXPECT_EQ(pixel(f, 50, 32), glm::vec4(0, 0, 1, 1));  // alpha ~0.79: opaque, full alpha
+    EXPECT_EQ(pixel(f, 10, 32), glm::vec4(0, 0, 0, 1)); // alpha ~0.16: discarded
+    EXPECT_EQ(pixel(f, 50, 32), glm::vec4(0, 0, 1, 1)); // alpha ~0.79: opaque, full alpha
     EXPECT_EQ(f.depth.load(32 * kSize + 10), 1.0f);
     EXPECT_LT(f.depth.load(32 * kSize + 50), 1.0f);
 }
@@ -155,15 +155,15 @@ raster::Scene busyScene() {
     for (int m = 0; m < 3; ++m) {
         raster::Primitive& p = addMesh(s, pos, {}, mats[m]);
         for (size_t t = size_t(m); t < pos.size() / 3; t += 3)
-            p.indices.insert(p.indices.end(), {uint32_t(3 * t), uint32_t(3 * t + 1),
-                                               uint32_t(3 * t + 2)});
+            p.indices.insert(p.indices.end(),
+                             {uint32_t(3 * t), uint32_t(3 * t + 1), uint32_t(3 * t + 2)});
     }
     return s;
 }
 
 TEST(Determinism, SameBitsForEveryThreadCountAndTileSize) {
     const raster::Scene s = busyScene();
-    raster::View v = pixelView(203, 157, 120.0f);  // odd sizes: partial tiles and quads
+    raster::View v = pixelView(203, 157, 120.0f); // odd sizes: partial tiles and quads
     raster::RenderOptions o;
     for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm16}) {
         o.depth_format = format;
@@ -178,5 +178,5 @@ TEST(Determinism, SameBitsForEveryThreadCountAndTileSize) {
     }
 }
 
-}  // namespace
-}  // namespace focal::test
+} // namespace
+} // namespace focal::test

@@ -4,9 +4,9 @@
 #include <raster/task_pool.h>
 #include <scenes/builtin.h>
 
-#include <cstring>
-
 #include <gtest/gtest.h>
+
+#include <cstring>
 
 // The kernels are internal to raster.
 #include "raster/src/light_kernel.h"
@@ -61,7 +61,7 @@ TEST(Simd, LightKernelMatchesScalarBitForBit) {
         state = state * 1664525u + 1013904223u;
         return float(state >> 8) / 16777216.0f;
     };
-    raster::Scene scene;  // lights of every type, incl. a ranged spot
+    raster::Scene scene; // lights of every type, incl. a ranged spot
     raster::Light sun;
     sun.direction = {0.3f, -1.0f, -0.2f};
     raster::Light bulb;
@@ -112,5 +112,5 @@ TEST(Simd, RendersMatchTheScalarPathOnBuiltinScenes) {
     }
 }
 
-}  // namespace
-}  // namespace focal::test
+} // namespace
+} // namespace focal::test

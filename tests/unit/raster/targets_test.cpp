@@ -4,9 +4,9 @@
 #include <raster/task_pool.h>
 #include <scenes/builtin.h>
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace focal::test {
 namespace {
@@ -26,14 +26,20 @@ raster::Scene stackScene(bool with_crossing) {
         const float cx = 0.12f * d * float(i % 3 - 1), cy = 0.1f * d * float(i % 2) - 0.05f * d;
         const int32_t m = addMaterial(
             s, flatMaterial({0.1f + 0.1f * float(i), 0.9f - 0.1f * float(i), 0.5f, 1.0f}));
-        addMesh(s, {{cx - h, cy - h, -d}, {cx + h, cy - h, -d}, {cx + h, cy + h, -d},
-                    {cx - h, cy + h, -d}},
+        addMesh(s,
+                {{cx - h, cy - h, -d},
+                 {cx + h, cy - h, -d},
+                 {cx + h, cy + h, -d},
+                 {cx - h, cy + h, -d}},
                 {0, 1, 2, 0, 2, 3}, m);
     }
     if (with_crossing) {
         const int32_t m = addMaterial(s, flatMaterial({1.0f, 1.0f, 0.0f, 1.0f}));
-        addMesh(s, {{-0.3f, -0.2f, -2.2f}, {0.3f, -0.2f, -2.2f}, {0.3f, 0.6f, -14.0f},
-                    {-0.3f, 0.6f, -14.0f}},
+        addMesh(s,
+                {{-0.3f, -0.2f, -2.2f},
+                 {0.3f, -0.2f, -2.2f},
+                 {0.3f, 0.6f, -14.0f},
+                 {-0.3f, 0.6f, -14.0f}},
                 {0, 1, 2, 0, 2, 3}, m);
     }
     return s;
@@ -105,17 +111,17 @@ TEST(LayeredTarget, ExactRoutingEqualsRendersClippedToEachLayer) {
             const glm::vec4 c = t.color.load(t.index(l, p));
             covered += in_ref;
             if (in_ref != (c.a > 0.0f)) {
-                ++mismatched;  // only where a clipped triangle's new edge is snapped differently
+                ++mismatched; // only where a clipped triangle's new edge is snapped differently
                 continue;
             }
             if (in_ref) {
-                EXPECT_EQ(glm::vec3(c), glm::vec3(pixel(ref, uint32_t(p % v.width),
-                                                         uint32_t(p / v.width))))
+                EXPECT_EQ(glm::vec3(c),
+                          glm::vec3(pixel(ref, uint32_t(p % v.width), uint32_t(p / v.width))))
                     << "layer " << l << " pixel " << p;
             }
         }
         EXPECT_GT(covered, 0u) << "layer " << l;
-        EXPECT_LE(mismatched, t.width) << "layer " << l;  // at most a row's worth along the cut
+        EXPECT_LE(mismatched, t.width) << "layer " << l; // at most a row's worth along the cut
     }
 }
 
@@ -127,8 +133,10 @@ TEST(LayeredTarget, PaperRoutingDiffersOnlyWhereTrianglesCrossBounds) {
               hashLayers(layers(plain, v, stackDesc(LayerRouting::PerFragment, 0.0f))));
     // With the slanted quad, differences stay inside its screen footprint.
     const raster::Scene crossing = stackScene(true);
-    const raster::LayeredTarget paper = layers(crossing, v, stackDesc(LayerRouting::MaxVertexDepth, 0.0f));
-    const raster::LayeredTarget exact = layers(crossing, v, stackDesc(LayerRouting::PerFragment, 0.0f));
+    const raster::LayeredTarget paper =
+        layers(crossing, v, stackDesc(LayerRouting::MaxVertexDepth, 0.0f));
+    const raster::LayeredTarget exact =
+        layers(crossing, v, stackDesc(LayerRouting::PerFragment, 0.0f));
     raster::Scene only_crossing = crossing;
     only_crossing.instances.erase(only_crossing.instances.begin(),
                                   only_crossing.instances.end() - 1);
@@ -143,7 +151,7 @@ TEST(LayeredTarget, PaperRoutingDiffersOnlyWhereTrianglesCrossBounds) {
             ++differing;
             EXPECT_LT(footprint.depth.load(p), 1.0f) << "layer " << l << " pixel " << p;
         }
-    EXPECT_GT(differing, 0u);  // the crossing quad does land in other layers
+    EXPECT_GT(differing, 0u); // the crossing quad does land in other layers
 }
 
 TEST(LayeredTarget, BitIdenticalAcrossThreadsAndTiles) {
@@ -170,7 +178,7 @@ TEST(LayeredTarget, HalfAndUnorm16StorageStayWithinTheirPrecision) {
         const float zf = full.depth.load(i), zs = small.depth.load(i);
         if (zf < 1.0f && std::abs(zf - zs) <= 0.5f / 65535.0f + 1e-7f) {
             const glm::vec4 cf = full.color.load(i), cs = small.color.load(i);
-            for (int k = 0; k < 4; ++k)  // half: 11 significant bits
+            for (int k = 0; k < 4; ++k) // half: 11 significant bits
                 EXPECT_LE(std::abs(cf[k] - cs[k]), std::abs(cf[k]) * 0x1p-11f + 1e-7f);
         }
     }
@@ -195,7 +203,7 @@ TEST(FragmentLists, EqualDepthPeeling) {
     const raster::Scene s = stackScene(true);
     const raster::View v = stackView();
     raster::FragmentListDesc desc;
-    desc.max_per_pixel = 0;  // keep all
+    desc.max_per_pixel = 0; // keep all
     desc.color_format = raster::ColorFormat::Float32;
     const raster::FragmentLists fl = lists(s, v, desc);
     EXPECT_GT(fl.max_list_length, 3u);
@@ -206,8 +214,8 @@ TEST(FragmentLists, EqualDepthPeeling) {
             if (k < fl.count(p)) {
                 const uint32_t i = fl.offsets[p] + k;
                 ASSERT_EQ(fl.depth.load(i), peeled.depth.load(p)) << "peel " << k << " px " << p;
-                EXPECT_EQ(fl.color.load(i), pixel(peeled, uint32_t(p % v.width),
-                                                  uint32_t(p / v.width)));
+                EXPECT_EQ(fl.color.load(i),
+                          pixel(peeled, uint32_t(p % v.width), uint32_t(p / v.width)));
             } else {
                 EXPECT_EQ(peeled.depth.load(p), 1.0f) << "peel " << k << " px " << p;
             }
@@ -235,7 +243,7 @@ TEST(FragmentLists, CapKeepsTheClosestN) {
             EXPECT_EQ(b.depth.load(b.offsets[p] + k), a.depth.load(a.offsets[p] + k));
             EXPECT_EQ(b.primitive[b.offsets[p] + k], a.primitive[a.offsets[p] + k]);
         }
-        for (uint32_t k = 1; k < a.count(p); ++k)  // sorted front to back
+        for (uint32_t k = 1; k < a.count(p); ++k) // sorted front to back
             EXPECT_LE(a.depth.load(a.offsets[p] + k - 1), a.depth.load(a.offsets[p] + k));
     }
 }
@@ -282,5 +290,5 @@ TEST(FragmentLists, BitIdenticalAcrossThreadsAndTilesOnFoliage) {
         }
 }
 
-}  // namespace
-}  // namespace focal::test
+} // namespace
+} // namespace focal::test

@@ -1,11 +1,11 @@
 // Texture decoding, mip chains, wrapping and filtering (issue 3, texture-filtering tests).
-#include <raster/texture.h>
-
 #include "support/test_util.h"
 
-#include <cmath>
+#include <raster/texture.h>
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace focal::test {
 namespace {
@@ -35,7 +35,8 @@ template <class F> Image makeImage(uint32_t w, uint32_t h, bool srgb, F value) {
 }
 
 Image checker(uint32_t size, bool srgb) {
-    return makeImage(size, size, srgb, [](uint32_t x, uint32_t y) { return (x + y) % 2 ? 255 : 0; });
+    return makeImage(size, size, srgb,
+                     [](uint32_t x, uint32_t y) { return (x + y) % 2 ? 255 : 0; });
 }
 
 TEST(Texture, SrgbTransferRoundTrips) {
@@ -48,12 +49,12 @@ TEST(Texture, SrgbTransferRoundTrips) {
 
 TEST(Texture, MipChainAveragesInLinearLight) {
     const Image img = checker(4, true);
-    ASSERT_EQ(img.levels.size(), 3u);  // 4x4, 2x2, 1x1
+    ASSERT_EQ(img.levels.size(), 3u); // 4x4, 2x2, 1x1
     // Black and white average to linear 0.5, which sRGB encodes as 188 (not 128).
     EXPECT_EQ(img.levels[1].rgba8[0], 188);
     EXPECT_EQ(img.levels[2].rgba8[0], 188);
     const Image non_square = makeImage(8, 2, false, [](uint32_t, uint32_t) { return 7; });
-    ASSERT_EQ(non_square.levels.size(), 4u);  // 8x2, 4x1, 2x1, 1x1
+    ASSERT_EQ(non_square.levels.size(), 4u); // 8x2, 4x1, 2x1, 1x1
     EXPECT_EQ(non_square.levels[1].width, 4u);
     EXPECT_EQ(non_square.levels[1].height, 1u);
     EXPECT_EQ(non_square.levels[3].width, 1u);
@@ -69,12 +70,12 @@ TEST(Texture, NearestFetchesTexelsAndWrapModesWrap) {
     };
     EXPECT_FLOAT_EQ(red(0.125f), 0.0f);
     EXPECT_FLOAT_EQ(red(0.375f), 80.0f / 255.0f);
-    EXPECT_FLOAT_EQ(red(1.375f), 80.0f / 255.0f);  // repeat
+    EXPECT_FLOAT_EQ(red(1.375f), 80.0f / 255.0f); // repeat
     s.wrap_s = Wrap::ClampToEdge;
     EXPECT_FLOAT_EQ(red(1.375f), 240.0f / 255.0f);
     EXPECT_FLOAT_EQ(red(-3.0f), 0.0f);
     s.wrap_s = Wrap::MirroredRepeat;
-    EXPECT_FLOAT_EQ(red(1.125f), 240.0f / 255.0f);  // mirrored: 1.125 -> 0.875
+    EXPECT_FLOAT_EQ(red(1.125f), 240.0f / 255.0f); // mirrored: 1.125 -> 0.875
     EXPECT_FLOAT_EQ(red(1.875f), 0.0f);
     EXPECT_FLOAT_EQ(red(-0.125f), 0.0f);
     // Non-finite and huge coordinates do not crash.
@@ -92,12 +93,11 @@ TEST(Texture, BilinearAndTrilinearInterpolate) {
     EXPECT_FLOAT_EQ(raster::sampleImage(img, s, FilterOverride::Nearest, {0.3f, 0.5f}, 0.0f).r,
                     0.0f);
     // Level 1 is the 1x1 average, 127.5 stored as 128: lod 0.5 at uv 0.25 mixes 0 and 128/255.
-    EXPECT_FLOAT_EQ(
-        raster::sampleImage(img, s, FilterOverride::Trilinear, {0.25f, 0.25f}, 0.5f).r,
-        0.5f * 128.0f / 255.0f);
+    EXPECT_FLOAT_EQ(raster::sampleImage(img, s, FilterOverride::Trilinear, {0.25f, 0.25f}, 0.5f).r,
+                    0.5f * 128.0f / 255.0f);
     // Bilinear ignores the mip chain.
-    EXPECT_FLOAT_EQ(
-        raster::sampleImage(img, s, FilterOverride::Bilinear, {0.25f, 0.25f}, 0.5f).r, 0.0f);
+    EXPECT_FLOAT_EQ(raster::sampleImage(img, s, FilterOverride::Bilinear, {0.25f, 0.25f}, 0.5f).r,
+                    0.0f);
 }
 
 TEST(Texture, MinifiedCheckerAveragesToMidGreyWithTrilinear) {
@@ -125,5 +125,5 @@ TEST(Texture, MinifiedCheckerAveragesToMidGreyWithTrilinear) {
         }
 }
 
-}  // namespace
-}  // namespace focal::test
+} // namespace
+} // namespace focal::test
