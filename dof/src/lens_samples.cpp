@@ -119,21 +119,32 @@ float radicalInverse(uint32_t base, uint64_t index) {
     return r < 1.0f ? r : 0x1.fffffep-1f;
 }
 
-glm::vec2 concentricDisk(glm::vec2 u) {
-    // Shirley & Chiu 1997, "A low distortion map between disk and square", with the polar
-    // form of Shirley's 2011 note (one branch per pair of wedges).
+namespace {
+
+// Shirley & Chiu 1997, "A low distortion map between disk and square", in the polar form of
+// Shirley's 2011 note (one branch per pair of wedges): a signed radius r (0 only at the centre)
+// and an angle phi.
+struct ConcentricPolar {
+    float r = 0.0f;
+    float phi = 0.0f;
+};
+
+ConcentricPolar concentricPolar(glm::vec2 u) {
     const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
     if (a == 0.0f && b == 0.0f)
+        return {};
+    if (std::fabs(a) > std::fabs(b))
+        return {a, (kPi / 4.0f) * (b / a)};
+    return {b, kPi / 2.0f - (kPi / 4.0f) * (a / b)};
+}
+
+} // namespace
+
+glm::vec2 concentricDisk(glm::vec2 u) {
+    const ConcentricPolar p = concentricPolar(u);
+    if (p.r == 0.0f)
         return {0.0f, 0.0f};
-    float r, phi;
-    if (std::fabs(a) > std::fabs(b)) {
-        r = a;
-        phi = (kPi / 4.0f) * (b / a);
-    } else {
-        r = b;
-        phi = kPi / 2.0f - (kPi / 4.0f) * (a / b);
-    }
-    return {r * std::cos(phi), r * std::sin(phi)};
+    return {p.r * std::cos(p.phi), p.r * std::sin(p.phi)};
 }
 
 uint32_t hashWords(uint32_t a, uint32_t b, uint32_t c, uint32_t d) {
@@ -221,17 +232,10 @@ glm::vec2 ApertureSampler::map(glm::vec2 u) const {
         // Concentric radius r (P(r < R) = R^2) and the ring position s in [0,1) (uniform for a
         // given r). The fan of `blades` triangles from the centre has equal areas, so s picks a
         // triangle and a point along its outer edge linearly; scaling by r keeps area uniform.
-        const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
-        if (a == 0.0f && b == 0.0f)
+        const ConcentricPolar polar = concentricPolar(u);
+        if (polar.r == 0.0f)
             return {0.0f, 0.0f};
-        float r, phi;
-        if (std::fabs(a) > std::fabs(b)) {
-            r = a;
-            phi = (kPi / 4.0f) * (b / a);
-        } else {
-            r = b;
-            phi = kPi / 2.0f - (kPi / 4.0f) * (a / b);
-        }
+        float r = polar.r, phi = polar.phi;
         if (r < 0.0f) {
             r = -r;
             phi += kPi;
