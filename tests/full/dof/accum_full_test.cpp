@@ -1,5 +1,6 @@
 // accum on the built-in scenes: determinism across thread counts and tile sizes, and
 // convergence of the reference itself (more views, closer to a high-N render).
+#include "support/builtin_case.h"
 #include "support/test_util.h"
 
 #include <dof/accum.h>
@@ -15,22 +16,6 @@
 
 namespace focal::test {
 namespace {
-
-struct BuiltinCase {
-    raster::Scene scene;
-    raster::View view;
-    dof::ThinLens lens;
-};
-
-BuiltinCase builtin(const char* name, uint32_t w, uint32_t h) {
-    raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(name);
-    EXPECT_TRUE(scene.ok());
-    BuiltinCase s{std::move(*scene), {}, {}};
-    s.view = raster::viewFromCamera(s.scene.cameras.at(0), w, h);
-    s.view.focus_distance = s.scene.lens->focus_distance;
-    s.lens = dof::makeThinLens(s.view, s.scene.lens->aperture_radius, s.view.focus_distance);
-    return s;
-}
 
 raster::Frame accum(const BuiltinCase& s, uint32_t n, uint32_t threads, uint32_t tile, bool jitter,
                     dof::LensPattern pattern = dof::LensPattern::Hammersley) {
@@ -51,7 +36,7 @@ raster::Frame accum(const BuiltinCase& s, uint32_t n, uint32_t threads, uint32_t
 }
 
 TEST(AccumFull, DemoIsDeterministicAcrossThreadsAndTiles) {
-    const BuiltinCase s = builtin("demo", 96, 72);
+    const BuiltinCase s = loadBuiltinCase("demo", 96, 72);
     const uint64_t reference = hashFrame(accum(s, 12, 0, 64, true));
     for (uint32_t threads : {1u, 2u, 3u, 8u})
         for (uint32_t tile : {8u, 32u, 64u, 256u})
@@ -68,7 +53,7 @@ double psnr(const raster::Frame& a, const raster::Frame& b) {
 }
 
 TEST(AccumFull, ConvergesWithMoreViews) {
-    const BuiltinCase s = builtin("demo", 96, 72);
+    const BuiltinCase s = loadBuiltinCase("demo", 96, 72);
     const raster::Frame high = accum(s, 1024, 2, 64, false);
     const double p16 = psnr(accum(s, 16, 2, 64, false), high);
     const double p64 = psnr(accum(s, 64, 2, 64, false), high);

@@ -3,6 +3,7 @@
 // layers, Fig. 8 first row), the crossing branches of Fig. 8 (second row) come out as accum
 // renders them, and per-ray shading (§5) beats view-independent shading on shiny spheres.
 #include "../../unit/dof/dof_test_util.h"
+#include "support/builtin_case.h"
 
 #include <dof/metrics.h>
 #include <dof/multiview.h>
@@ -13,22 +14,7 @@
 namespace focal::test {
 namespace {
 
-struct Case {
-    raster::Scene scene;
-    raster::View view;
-    dof::ThinLens lens;
-};
-
-Case load(const char* name, uint32_t w, uint32_t h) {
-    raster::Result<raster::Scene> s = scenes::makeBuiltinScene(name);
-    FOCAL_CHECK(s.ok());
-    Case c{std::move(*s), {}, {}};
-    c.view = raster::viewFromCamera(c.scene.cameras[0], w, h);
-    c.lens = dof::makeThinLens(c.view, c.scene.lens->aperture_radius, c.scene.lens->focus_distance);
-    return c;
-}
-
-std::vector<float> multiview(const Case& c, const dof::LensSampleSet& samples,
+std::vector<float> multiview(const BuiltinCase& c, const dof::LensSampleSet& samples,
                              const dof::MultiviewSettings& s, raster::Frame* pinhole = nullptr) {
     raster::TaskPool pool(2);
     raster::Renderer renderer(pool);
@@ -58,7 +44,7 @@ dof::ErrorMetrics compare(const std::vector<float>& a, const raster::Frame& ref,
 }
 
 TEST(MultiviewScenes, RailingBackgroundShowsThroughNearBars) {
-    const Case c = load("railing", 320, 240);
+    const BuiltinCase c = loadBuiltinCase("railing", 320, 240);
     const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, makeSamples(256), {}, 2);
     raster::Frame pinhole;
     const std::vector<float> mv = multiview(c, makeSamples(64), {}, &pinhole);
@@ -79,7 +65,7 @@ TEST(MultiviewScenes, RailingBackgroundShowsThroughNearBars) {
 }
 
 TEST(MultiviewScenes, BranchesMatchTheReference) {
-    const Case c = load("branches", 320, 240);
+    const BuiltinCase c = loadBuiltinCase("branches", 320, 240);
     const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, makeSamples(256), {}, 2);
     raster::Frame pinhole;
     // Eq. 4 spaces layers by delta pixels of CoC, so at 320x240 (f_px 0.4x that of 800x600) a
@@ -98,7 +84,7 @@ TEST(MultiviewScenes, BranchesMatchTheReference) {
 }
 
 TEST(MultiviewScenes, ViewDependentShadingBeatsViewIndependent) {
-    const Case c = load("reflective", 320, 240);
+    const BuiltinCase c = loadBuiltinCase("reflective", 320, 240);
     raster::RenderOptions lit;
     const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, makeSamples(256), {}, 2);
     dof::MultiviewSettings vd;
