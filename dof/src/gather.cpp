@@ -59,7 +59,33 @@ struct Plan {
     uint32_t reach = 0;      // ceil(R) - 1
     uint32_t row_blocks = 0; // ceil(H / 8)
     uint32_t col_blocks = 0; // ceil(W / 8)
+
+    // Pixel rectangle [x0, x1) x [y0, y1) of a work tile.
+    struct Bounds {
+        uint32_t x0, y0, x1, y1;
+    };
+    Bounds bounds(uint32_t t) const {
+        const uint32_t x0 = (t % tiles_x) * tile, y0 = (t / tiles_x) * tile;
+        return {x0, y0, std::min(width, x0 + tile), std::min(height, y0 + tile)};
+    }
 };
+
+// A worker's scratch for one pass: RGBA and weight accumulators for a tile-long line, and the
+// padded line the horizontal pass reads (r, I, behind, RGBA).
+struct LineScratch {
+    float* acc;    // 4 per pixel
+    float* wsum;   // total weight
+    float* nsum;   // weight of samples in front
+    float* leak_c; // leakage control of the centre
+    float* pad;    // padded line
+};
+LineScratch lineScratch(float* base, uint32_t tile) {
+    float* acc = base;
+    float* wsum = acc + 4 * tile;
+    float* nsum = wsum + tile;
+    float* leak_c = nsum + tile;
+    return {acc, wsum, nsum, leak_c, leak_c + tile};
+}
 
 Status checkImage(const GatherImage& image) {
     if (image.width == 0 || image.height == 0)
@@ -294,9 +320,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
     // --- coc: C = a D + b and the per-pixel weight terms (§4.1, §4.2) ---
     auto t0 = std::chrono::steady_clock::now();
     runTasks(pool, tiles, [&](uint32_t tile, uint32_t) {
-        const uint32_t tx = tile % p.tiles_x, ty = tile / p.tiles_x;
-        const uint32_t x0 = tx * p.tile, x1 = std::min(p.width, x0 + p.tile);
-        const uint32_t y0 = ty * p.tile, y1 = std::min(p.height, y0 + p.tile);
+        const auto [x0, y0, x1, y1] = p.bounds(tile);
         TileCoc& tc = tile_coc[tile];
         for (uint32_t y = y0; y < y1; ++y) {
             for (uint32_t x = x0; x < x1; ++x) {
@@ -319,7 +343,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
                 tc.min_c = std::min(tc.min_c, t.coc);
                 tc.max_c = std::max(tc.max_c, t.coc);
                 tc.clamped += std::fabs(t.coc) > settings.max_radius_px ? 1u : 0u;
-                float& vb = vblock[size_t(tx) * p.row_blocks + y / kBlock];
+                float& vb = vblock[size_t(tile % p.tiles_x) * p.row_blocks + y / kBlock];
                 float& hb = hblock[size_t(y) * p.col_blocks + x / kBlock];
                 vb = std::max(vb, t.radius);
                 hb = std::max(hb, t.radius);
@@ -351,14 +375,11 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
     // --- vertical pass (§4.2, first pass): down the columns of the pinhole colour ---
     t0 = std::chrono::steady_clock::now();
     runTasks(pool, tiles, [&](uint32_t tile, uint32_t worker) {
-        const uint32_t tx = tile % p.tiles_x, ty = tile / p.tiles_x;
-        const uint32_t x0 = tx * p.tile, x1 = std::min(p.width, x0 + p.tile);
-        const uint32_t y0 = ty * p.tile, y1 = std::min(p.height, y0 + p.tile);
+        const auto [x0, y0, x1, y1] = p.bounds(tile);
         const uint32_t n = x1 - x0;
-        float* acc = ws.worker.data() + worker * worker_floats;
-        float* wsum = acc + 4 * p.tile;
-        float* nsum = wsum + p.tile;
-        float* leak_c = nsum + p.tile;
+        const auto [acc, wsum, nsum, leak_c, pad] =
+            lineScratch(ws.worker.data() + worker * worker_floats, p.tile);
+        (void)pad; // the vertical pass reads the image directly
         uint64_t samples = 0;
         bool any_filtered = false;
         for (uint32_t yb = y0; yb < y1; yb += kBlock) {
@@ -369,7 +390,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
                 const uint32_t hi = std::min(p.height - 1, yb + kBlock - 1 + p.reach) / kBlock;
                 float max_r = 0.0f;
                 for (uint32_t b = lo; b <= hi; ++b)
-                    max_r = std::max(max_r, vblock[size_t(tx) * p.row_blocks + b]);
+                    max_r = std::max(max_r, vblock[size_t(tile % p.tiles_x) * p.row_blocks + b]);
                 k_max = std::min(p.reach, reachOf(max_r));
             } else {
                 k_max = p.reach;
@@ -420,15 +441,10 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
     // --- horizontal pass (§4.2, second pass): along the rows of the vertical output ---
     t0 = std::chrono::steady_clock::now();
     runTasks(pool, tiles, [&](uint32_t tile, uint32_t worker) {
-        const uint32_t tx = tile % p.tiles_x, ty = tile / p.tiles_x;
-        const uint32_t x0 = tx * p.tile, x1 = std::min(p.width, x0 + p.tile);
-        const uint32_t y0 = ty * p.tile, y1 = std::min(p.height, y0 + p.tile);
+        const auto [x0, y0, x1, y1] = p.bounds(tile);
         const uint32_t n = x1 - x0;
-        float* acc = ws.worker.data() + worker * worker_floats;
-        float* wsum = acc + 4 * p.tile;
-        float* nsum = wsum + p.tile;
-        float* leak_c = nsum + p.tile;
-        float* pad = leak_c + p.tile; // padded row: r, I, behind, RGBA
+        const auto [acc, wsum, nsum, leak_c, pad] =
+            lineScratch(ws.worker.data() + worker * worker_floats, p.tile);
         const size_t pad_len = size_t(p.tile) + 2 * p.reach;
         float* pr = pad;
         float* pi = pr + pad_len;
