@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <optional>
 #include <string>
@@ -27,6 +28,9 @@ struct MultiviewArgs {
     float overlap = 0.1f;
     uint32_t iterations = 3;
     uint32_t refine_steps = 4;
+    std::string traversal = "scan";
+    std::string bound_init = "off";
+    std::string thickness = "2";
     std::string cone = "on";
     std::string culling = "on";
     std::string jitter = "noise";
@@ -258,6 +262,17 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     s.overlap = a.overlap;
     s.iterations = a.iterations;
     s.refine_steps = a.refine_steps;
+    s.traversal = a.traversal == "scan" ? dof::Traversal::Scan : dof::Traversal::FalsePosition;
+    s.bound_init = a.bound_init == "on";
+    if (a.thickness != "inf") {
+        char* end = nullptr;
+        s.thickness_px = std::strtof(a.thickness.c_str(), &end);
+        if (a.thickness.empty() || *end != '\0' || !std::isfinite(s.thickness_px) ||
+            !(s.thickness_px > 0.0f))
+            return raster::Status::error("--thickness must be a positive number of pixels or "
+                                         "inf, got '" +
+                                         a.thickness + "'");
+    }
     s.cone = a.cone == "on";
     s.culling = a.culling == "on";
     s.jitter = a.jitter == "none"     ? dof::JitterMode::None
@@ -358,6 +373,9 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"overlap", a.overlap},
         {"iterations", a.iterations},
         {"refine_steps", a.refine_steps},
+        {"traversal", a.traversal},
+        {"bound_init", s.bound_init},
+        {"thickness_px", a.thickness},
         {"cone", s.cone},
         {"culling", s.culling},
         {"jitter", jitterName(s.jitter)},
@@ -423,6 +441,20 @@ MethodEntry makeMultiviewMethod() {
                        "multiview: binary-search steps after the false position (Sec. 4.3)")
             ->capture_default_str()
             ->check(CLI::Range(0, 32));
+        cmd.add_option("--traversal", args->traversal,
+                       "multiview: height-field intersection: false-position (the paper, Sec. "
+                       "4.3) or scan (every texel on the path, exact; Sec. 6)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"false-position", "scan"}));
+        cmd.add_option("--bound-init", args->bound_init,
+                       "multiview: start the false position from the layer's depth bounds and "
+                       "look up the segment ends only when the first point is empty (Sec. 4.3)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"on", "off"}));
+        cmd.add_option("--thickness", args->thickness,
+                       "multiview: with --traversal scan, how far behind its depth a layer texel "
+                       "is solid, as a CoC difference in pixels; inf = the paper's height field")
+            ->capture_default_str();
         cmd.add_option("--cone", args->cone, "multiview: approximate cone tracing (Sec. 4.4)")
             ->capture_default_str()
             ->check(CLI::IsMember({"on", "off"}));

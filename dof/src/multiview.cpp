@@ -65,7 +65,8 @@ struct Tracer {
     uint32_t width = 0, height = 0;
     float coc_a = 0.0f, coc_b = 0.0f; // C(D) = coc_a + coc_b * D
     float lambda = 0.0f;
-    float r_max = 1.0f; // bound of |v| over every lens position a ray may use
+    float r_max = 1.0f;           // bound of |v| over every lens position a ray may use
+    float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     glm::vec3 background{0.0f};
 
     float cocOf(float t) const { return coc_a + coc_b * t; }
@@ -75,15 +76,13 @@ float distanceFromD(const raster::View& view, float d_stored) {
     return raster::distanceFromDepth(view, d_stored);
 }
 
-// §4.3 "Ray Traversal": the lens ray's segment in layer `l` against the layer's height field,
-// by the method of false position followed by a binary search. The ray's image position at
-// depth t is p + C(t) * w (Eq. 2-3, lens.h), w = (-v.x, v.y).
-Hit traceLayer(const Tracer& tr, uint32_t l, float s0, float s1, float cx, float cy, glm::vec2 w,
-               TileCounters& cnt) {
-    const float* depth = tr.scratch->depth[l].data();
+// §4.3 "Ray Traversal": the lens ray's segment [s0, s1] in one height field (`depth`, a layer's
+// stored D per texel) by the method of false position followed by a binary search. The ray's
+// image position at depth t is p + C(t) * w (Eq. 2-3, lens.h), w = (-v.x, v.y).
+Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
+                     float cx, float cy, glm::vec2 w, TileCounters& cnt) {
     const uint32_t width = tr.width, height = tr.height;
     const bool clamp = tr.settings->offscreen == OffscreenPolicy::Clamp;
-    const float seg_near = tr.segs[l].t0;
     struct Sample {
         float h; // stored D of the texel, or kEmptyDepth
         uint32_t texel;
@@ -114,33 +113,52 @@ Hit traceLayer(const Tracer& tr, uint32_t l, float s0, float s1, float cx, float
     auto fInterior = [&](float t, const Sample& s) {
         return s.covered ? t - std::clamp(s.h, s0, s1) : t - s1;
     };
+    auto fFarEnd = [&](const Sample& s) {
+        return s.covered ? s1 - std::clamp(s.h, s0, s1) : s1 - s0;
+    };
 
-    Hit hit;
-    const Sample a = fetch(s0);
-    float ta = s0, fa = fInterior(s0, a);
-    if (a.covered && fa >= 0.0f) { // the surface is at or before the segment's start
-        hit.hit = true;
-        hit.t = s0;
-        hit.texel = a.texel;
-        return hit;
-    }
-    Sample b = fetch(s1);
-    float tb = s1, fb = b.covered ? s1 - std::clamp(b.h, s0, s1) : s1 - s0;
-    // Method of false position: intersect the ray with the line through (ta, fa), (tb, fb).
-    for (uint32_t k = 0; k < tr.settings->iterations; ++k) {
-        const float denom = fb - fa;
-        if (!(denom > 0.0f))
-            break;
-        const float ti = ta + (tb - ta) * (-fa / denom);
-        if (!(ti > ta && ti < tb))
-            break;
+    float ta = s0, fa, tb = s1, fb;
+    std::optional<Sample> b; // the sample at tb, fetched when needed
+    bool bracketed = false;
+    if (tr.settings->bound_init) {
+        // §4.3's shortcut: take d_u, d_l as the layer's bounds (f(s0) = s0 - s1, f(s1) = s1 - s0),
+        // so the first intersection point is the segment's middle; only when the texel under it
+        // is empty are the two end lookups made.
+        fa = s0 - s1, fb = s1 - s0;
+        const float ti = 0.5f * (s0 + s1);
         const Sample si = fetch(ti);
-        const float fi = fInterior(ti, si);
-        if (fi >= 0.0f) { // the surface is before I: the crossing lies in [ta, ti]
-            tb = ti, fb = fi, b = si;
-            break;
+        if (si.covered) {
+            const float fi = fInterior(ti, si);
+            if (fi >= 0.0f)
+                tb = ti, fb = fi, b = si;
+            else
+                ta = ti, fa = fi;
+            bracketed = true;
         }
-        ta = ti, fa = fi; // restart with the farther sub-segment
+    }
+    if (!bracketed) {
+        const Sample a = fetch(s0);
+        fa = fInterior(s0, a);
+        if (a.covered && fa >= 0.0f) // the surface is at or before the segment's start
+            return {true, s0, a.texel};
+        b = fetch(s1);
+        fb = fFarEnd(*b);
+        // Method of false position: intersect the ray with the line through (ta, fa), (tb, fb).
+        for (uint32_t k = 0; k < tr.settings->iterations; ++k) {
+            const float denom = fb - fa;
+            if (!(denom > 0.0f))
+                break;
+            const float ti = ta + (tb - ta) * (-fa / denom);
+            if (!(ti > ta && ti < tb))
+                break;
+            const Sample si = fetch(ti);
+            const float fi = fInterior(ti, si);
+            if (fi >= 0.0f) { // the surface is before I: the crossing lies in [ta, ti]
+                tb = ti, fb = fi, b = si;
+                break;
+            }
+            ta = ti, fa = fi; // restart with the farther sub-segment
+        }
     }
     // Binary search refinement of the bracket [ta, tb].
     for (uint32_t k = 0; k < tr.settings->refine_steps; ++k) {
@@ -154,12 +172,58 @@ Hit traceLayer(const Tracer& tr, uint32_t l, float s0, float s1, float cx, float
         else
             ta = tm, fa = fm;
     }
-    if (b.covered) {
-        hit.hit = true;
-        hit.t = tb;
-        hit.texel = b.texel;
+    if (!b)
+        b = fetch(tb); // the shortcut's far end, never looked up
+    if (b->covered)
+        return {true, tb, b->texel};
+    return {};
+}
+
+// The exact alternative to the false position that §6 names ("brute-force scanning finds
+// accurate intersection points"): walk every texel the segment's image path crosses (a 2D
+// DDA) and stop in the first one whose surface the ray reaches while inside its column. A texel
+// is solid over [h, h + thickness], so with a bounded thickness a ray that enters a column
+// already behind its surface passes behind it.
+Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
+                    float cx, float cy, glm::vec2 w, TileCounters& cnt) {
+    const bool clamp = tr.settings->offscreen == OffscreenPolicy::Clamp;
+    const float c0 = tr.cocOf(s0), c1 = tr.cocOf(s1);
+    const float x0 = cx + c0 * w.x, y0 = cy + c0 * w.y;
+    const float dx = (c1 - c0) * w.x, dy = (c1 - c0) * w.y; // image path, u in [0, 1]
+    int64_t ix = int64_t(std::floor(x0)), iy = int64_t(std::floor(y0));
+    const int64_t step_x = dx > 0.0f ? 1 : -1, step_y = dy > 0.0f ? 1 : -1;
+    // u at which the path crosses the next column / row boundary, and per cell.
+    const float delta_x = dx != 0.0f ? 1.0f / std::fabs(dx) : INFINITY;
+    const float delta_y = dy != 0.0f ? 1.0f / std::fabs(dy) : INFINITY;
+    float next_x =
+        dx != 0.0f ? (dx > 0.0f ? float(ix + 1) - x0 : x0 - float(ix)) * delta_x : INFINITY;
+    float next_y =
+        dy != 0.0f ? (dy > 0.0f ? float(iy + 1) - y0 : y0 - float(iy)) * delta_y : INFINITY;
+    const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
+    float u_in = 0.0f;
+    for (;;) {
+        const float u_out = std::min({next_x, next_y, 1.0f});
+        int64_t qx = ix, qy = iy;
+        if (clamp)
+            qx = std::clamp<int64_t>(qx, 0, w_max), qy = std::clamp<int64_t>(qy, 0, h_max);
+        if (qx >= 0 && qy >= 0 && qx <= w_max && qy <= h_max) {
+            ++cnt.fetches;
+            const uint32_t texel = uint32_t(qy) * tr.width + uint32_t(qx);
+            const float h = depth[texel];
+            const float t_in = s0 + u_in * (s1 - s0), t_out = s0 + u_out * (s1 - s0);
+            // Covered as in the false position (texels outside the layer's extent are empty);
+            // the ray reaches the surface inside this column and is not past its thickness.
+            if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d)
+                return {true, std::clamp(h, t_in, t_out), texel};
+        }
+        if (u_out >= 1.0f)
+            return {};
+        u_in = u_out;
+        if (next_x <= next_y)
+            ix += step_x, next_x += delta_x;
+        else
+            iy += step_y, next_y += delta_y;
     }
-    return hit;
 }
 
 // Trilinear lookup of the premultiplied coverage mipmap of layer l (§4.4) at image position
@@ -401,7 +465,11 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 }
             }
             ++cnt.layer_tests;
-            const Hit h = traceLayer(tr, l, s0, seg.t1, cx, cy, w, cnt);
+            const Hit h = s.traversal == Traversal::Scan
+                              ? scanHeightField(tr, tr.scratch->depth[l].data(), seg.t0, s0, seg.t1,
+                                                cx, cy, w, cnt)
+                              : traceHeightField(tr, tr.scratch->depth[l].data(), seg.t0, s0,
+                                                 seg.t1, cx, cy, w, cnt);
             if (!h.hit)
                 continue;
             const float c_hit = tr.cocOf(h.t);
@@ -489,6 +557,8 @@ Status validate(const MultiviewSettings& s, uint32_t sample_count) {
         return Status::error("--layers must be at most " + std::to_string(raster::kMaxLayers));
     if (!std::isfinite(s.overlap) || s.overlap < 0.0f || s.overlap > 1.0f)
         return Status::error("--overlap must be in [0, 1]");
+    if (std::isnan(s.thickness_px) || !(s.thickness_px > 0.0f))
+        return Status::error("--thickness must be a positive number of pixels or inf");
     if (s.iterations > 64)
         return Status::error("--iterations must be at most 64");
     if (s.refine_steps > 32)
@@ -603,6 +673,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         tr.coc_a = float(ef * (1.0 / double(lens.focus_distance) - inv_n));
         tr.coc_b = float(ef * (inv_n - inv_f));
     }
+    if (std::isfinite(settings.thickness_px) && tr.coc_b != 0.0f)
+        tr.thickness_d = settings.thickness_px / std::fabs(tr.coc_b);
     tr.lambda = meanNeighbourDistance(samples);
     stats.lambda = tr.lambda;
     float r_max = 0.0f;

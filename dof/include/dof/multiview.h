@@ -24,6 +24,7 @@
 #include <raster/status.h>
 #include <raster/task_pool.h>
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -40,6 +41,12 @@ enum class JitterMode : uint8_t {
     Halton, // the paper's best quality: a 2N-sample sequence, each pixel takes N consecutive
             // samples from an offset in [0, 2N-1] (needs MultiviewSettings::sequence_2n)
     Rotate, // a per-pixel Cranley-Patterson rotation of the pattern (LensSampleSet::sample(x,y,i))
+};
+
+// How a lens ray's segment is intersected with a layer's height field (§4.3).
+enum class Traversal : uint8_t {
+    FalsePosition, // the paper: false-position steps, then a binary search (approximate)
+    Scan,          // every texel the segment crosses (§6's "brute-force scanning": exact)
 };
 
 // What happens to a lens ray whose path leaves the image (§4.3 "Handling Off-Screen Pixels").
@@ -89,8 +96,17 @@ struct MultiviewSettings {
     raster::DepthFormat depth_format = raster::DepthFormat::Float32;
     uint32_t iterations = 3;   // false-position steps per layer (§4.3: "three ... enough")
     uint32_t refine_steps = 4; // binary-search steps after the bracketing (§4.3)
-    bool culling = true;       // §4.3 early layer culling with N-buffers (lossless)
-    bool cone = true;          // §4.4 approximate cone tracing
+    // §4.3's shortcut: start the false position from the layer's depth bounds as d_u, d_l, and
+    // look the segment's end texels up only when the texel under the first point is empty.
+    bool bound_init = false;
+    Traversal traversal = Traversal::Scan;
+    // How far behind its stored depth a covered texel is solid (used by Traversal::Scan; the
+    // false position needs a closed height field to bracket its crossings), as a CoC difference in
+    // pixels (converted to D with Eq. 3). INFINITY is the paper's height field: solid down to the
+    // layer's far end, so a ray passing behind a thin object in the same layer stops on it.
+    float thickness_px = 2.0f;
+    bool culling = true; // §4.3 early layer culling with N-buffers (lossless)
+    bool cone = true;    // §4.4 approximate cone tracing
     JitterMode jitter = JitterMode::Noise;
     uint32_t seed = 0; // jitter key
     OffscreenPolicy offscreen = OffscreenPolicy::Discard;
