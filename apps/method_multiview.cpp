@@ -404,6 +404,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                   {"layers_culled_ray", st.layer_culled_ray},
                   {"cone_partial", st.cone_partial},
                   {"texel_fetches", st.texel_fetches},
+                  {"transparent_hits", st.transparent_hits},
                   {"layered_bytes", st.layered_bytes},
                   {"scratch_bytes", st.scratch_bytes}};
     out.stage_ms = {{"pinhole", st.ms_pinhole},

@@ -69,28 +69,51 @@ Status dumpLayers(const raster::LayeredTarget& layers, const raster::View& view,
     index["routing"] = layers.desc.routing == raster::LayerRouting::MaxVertexDepth
                            ? "max-vertex-depth"
                            : "per-fragment";
-    for (uint32_t l = 0; l < layers.layer_count; ++l) {
+    // One plane (colour + depth) of layer l as PREFIX_color.png and PREFIX_depth.exr; returns
+    // the covered pixel count.
+    auto dumpPlane = [&](uint32_t l, const raster::ColorBuffer& colors,
+                         const raster::DepthBuffer& depths,
+                         const std::string& suffix) -> raster::Result<size_t> {
         ImageData color{layers.width, layers.height, 4, std::vector<float>(pixels * 4)};
         ImageData depth{layers.width, layers.height, 1, std::vector<float>(pixels)};
         size_t covered = 0;
         for (size_t p = 0; p < pixels; ++p) {
-            const glm::vec4 c = layers.color.load(layers.index(l, p));
+            const glm::vec4 c = colors.load(layers.index(l, p));
             for (int k = 0; k < 4; ++k)
                 color.pixels[p * 4 + size_t(k)] = c[k];
-            const float d = layers.depth.load(layers.index(l, p));
+            const float d = depths.load(layers.index(l, p));
             depth.pixels[p] = d < 1.0f ? raster::distanceFromDepth(view, d) : 0.0f;
             covered += c.a > 0.0f;
         }
-        if (Status s = writeImage(numbered(dir, "layer", l, "_color.png"), color); !s.ok())
+        if (Status s =
+                writeImage(numbered(dir, "layer", l, (suffix + "_color.png").c_str()), color);
+            !s.ok())
             return s;
-        if (Status s = writeImage(numbered(dir, "layer", l, "_depth.exr"), depth); !s.ok())
+        if (Status s =
+                writeImage(numbered(dir, "layer", l, (suffix + "_depth.exr").c_str()), depth);
+            !s.ok())
             return s;
+        return covered;
+    };
+    for (uint32_t l = 0; l < layers.layer_count; ++l) {
+        raster::Result<size_t> covered = dumpPlane(l, layers.color, layers.depth, "");
+        if (!covered.ok())
+            return covered.status();
+        size_t transparent = 0;
+        if (layers.hasTransparency()) { // BLEND surfaces: premultiplied colour, alpha = opacity
+            raster::Result<size_t> t =
+                dumpPlane(l, layers.transparent_color, layers.transparent_depth, "_transparent");
+            if (!t.ok())
+                return t.status();
+            transparent = *t;
+        }
         const raster::LayerInterval iv = raster::overlappedInterval(layers.desc, l);
         index["layers"].push_back({{"near", layers.desc.bounds[l]},
                                    {"far", layers.desc.bounds[l + 1]},
                                    {"overlapped_near", iv.near_d},
                                    {"overlapped_far", std::isfinite(iv.far_d) ? iv.far_d : -1.0f},
-                                   {"covered_pixels", covered}});
+                                   {"covered_pixels", *covered},
+                                   {"transparent_pixels", transparent}});
     }
     return writeTextFile((std::filesystem::path(dir) / "layers.json").string(),
                          index.dump(2) + "\n");

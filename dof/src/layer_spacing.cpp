@@ -53,20 +53,17 @@ Status checkRange(const DepthRange& range) {
 } // namespace
 
 DepthRange visibleDepthRange(const raster::Frame& pinhole, const raster::View& view) {
-    // One pass in pixel order: min/max are order-independent, so this is deterministic.
+    // One pass in pixel order (BLEND surfaces included): min/max are order-independent, so this
+    // is deterministic.
     DepthRange r;
     float lo = INFINITY, hi = 0.0f;
-    const size_t pixels = size_t(pinhole.width) * pinhole.height;
-    for (size_t i = 0; i < pixels; ++i) {
-        const float stored = pinhole.depth.load(i);
-        if (!(stored < 1.0f))
-            continue;
+    raster::forEachVisibleDepth(pinhole, [&](float stored) {
         const float d = raster::distanceFromDepth(view, stored);
         if (!std::isfinite(d) || !(d > 0.0f))
-            continue;
+            return;
         lo = std::min(lo, d);
         hi = std::max(hi, d);
-    }
+    });
     if (hi > 0.0f) {
         r.near_d = lo;
         r.far_d = hi;

@@ -67,11 +67,7 @@ raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const r
 CocRange visibleCocRange(const ThinLens& lens, const raster::Frame& pinhole,
                          const raster::View& view) {
     CocRange r;
-    const uint32_t count = pinhole.width * pinhole.height;
-    for (uint32_t i = 0; i < count; ++i) {
-        const float stored = pinhole.depth.load(i);
-        if (stored >= 1.0f)
-            continue;
+    raster::forEachVisibleDepth(pinhole, [&](float stored) {
         const float c = cocRadiusPx(lens, raster::distanceFromDepth(view, stored));
         if (!r.covered) {
             r.min_px = r.max_px = c;
@@ -79,7 +75,7 @@ CocRange visibleCocRange(const ThinLens& lens, const raster::Frame& pinhole,
         }
         r.min_px = std::fmin(r.min_px, c);
         r.max_px = std::fmax(r.max_px, c);
-    }
+    });
     r.max_abs_px = std::fmax(std::fabs(r.min_px), std::fabs(r.max_px));
     return r;
 }

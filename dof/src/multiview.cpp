@@ -47,7 +47,7 @@ struct Hit {
 
 struct TileCounters {
     uint64_t rays = 0, discarded = 0, background = 0, layer_tests = 0, culled_pixel = 0,
-             culled_tile = 0, culled_ray = 0, cone_partial = 0, fetches = 0;
+             culled_tile = 0, culled_ray = 0, cone_partial = 0, fetches = 0, transparent_hits = 0;
 };
 
 // Everything the per-pixel loop reads; built once per frame.
@@ -226,9 +226,10 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
     }
 }
 
-// Trilinear lookup of the premultiplied coverage mipmap of layer l (§4.4) at image position
+// Trilinear lookup of a layer's premultiplied coverage mipmap `mip` (§4.4) at image position
 // (px, py) for a window of `diameter` pixels.
-glm::vec4 sampleCone(const Tracer& tr, uint32_t l, float px, float py, float diameter) {
+glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mip, float px,
+                     float py, float diameter) {
     const MultiviewScratch& sc = *tr.scratch;
     const uint32_t top = uint32_t(sc.mip_width.size()) - 1;
     const float level = std::clamp(std::log2(std::max(diameter, 1.0f)), 0.0f, float(top));
@@ -236,7 +237,7 @@ glm::vec4 sampleCone(const Tracer& tr, uint32_t l, float px, float py, float dia
     const uint32_t l1 = std::min(l0 + 1, top);
     const float f = level - float(l0);
     auto bilinear = [&](uint32_t lv) {
-        const std::vector<float>& img = sc.mips[l][lv];
+        const std::vector<float>& img = mip[lv];
         const uint32_t w = sc.mip_width[lv], h = sc.mip_height[lv];
         const float scale = 1.0f / float(1u << lv);
         const float u = px * scale - 0.5f, v = py * scale - 0.5f;
@@ -465,11 +466,29 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 }
             }
             ++cnt.layer_tests;
-            const Hit h = s.traversal == Traversal::Scan
-                              ? scanHeightField(tr, tr.scratch->depth[l].data(), seg.t0, s0, seg.t1,
-                                                cx, cy, w, cnt)
-                              : traceHeightField(tr, tr.scratch->depth[l].data(), seg.t0, s0,
-                                                 seg.t1, cx, cy, w, cnt);
+            auto trace = [&](const std::vector<float>& depth, float s1) {
+                return s.traversal == Traversal::Scan
+                           ? scanHeightField(tr, depth.data(), seg.t0, s0, s1, cx, cy, w, cnt)
+                           : traceHeightField(tr, depth.data(), seg.t0, s0, s1, cx, cy, w, cnt);
+            };
+            const Hit h = trace(tr.scratch->depth[l], seg.t1);
+            if (!tr.scratch->transparent_depth.empty()) {
+                // The layer's transparent plane, in front of its opaque hit: its premultiplied
+                // colour is added and the rest of the ray is seen through (1 - opacity); with
+                // cone tracing both come from its mipmap over the cone's footprint (§4.4).
+                const Hit ht = trace(tr.scratch->transparent_depth[l], h.hit ? h.t : seg.t1);
+                if (ht.hit) {
+                    ++cnt.transparent_hits;
+                    const float ct = tr.cocOf(ht.t);
+                    const glm::vec4 m =
+                        s.cone && tr.lambda * std::fabs(ct) > 1.0f
+                            ? sampleCone(tr, tr.scratch->transparent_mips[l], cx + ct * w.x,
+                                         cy + ct * w.y, tr.lambda * std::fabs(ct))
+                            : lt.transparent_color.load(lt.index(l, ht.texel));
+                    color += transmit * glm::vec3(m);
+                    transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
+                }
+            }
             if (!h.hit)
                 continue;
             const float c_hit = tr.cocOf(h.t);
@@ -479,8 +498,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             if (cone_hit) {
                 // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha
                 // is its coverage v1, the mipmapped RGB / v1 its mean colour c1.
-                const glm::vec4 m = sampleCone(tr, l, cx + c_hit * w.x, cy + c_hit * w.y,
-                                               tr.lambda * std::fabs(c_hit));
+                const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], cx + c_hit * w.x,
+                                               cy + c_hit * w.y, tr.lambda * std::fabs(c_hit));
                 v1 = std::clamp(m.a, 0.0f, 1.0f);
                 c1 = v1 > 0.0f ? glm::vec3(m) / m.a : glm::vec3(0.0f);
             } else {
@@ -691,23 +710,30 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     // mipmaps; one task per layer, each writing only its own slots.
     auto t0 = Clock::now();
     const size_t pixels = size_t(width) * height;
+    const bool transparency = layers.hasTransparency();
     scratch.depth.resize(m);
+    scratch.transparent_depth.resize(transparency ? m : 0);
     scratch.nbuffers.assign(m, NBuffer{});
     std::vector<float> content_min(m, INFINITY), content_max(m, -INFINITY);
     pool.parallelFor(m, [&](uint32_t l, uint32_t) {
-        std::vector<float>& d = scratch.depth[l];
-        d.resize(pixels);
         float lo = INFINITY, hi = -INFINITY;
-        for (size_t i = 0; i < pixels; ++i) {
-            const size_t li = layers.index(l, i);
-            const bool covered = layers.color.load(li).a > 0.0f;
-            const float v = covered ? layers.depth.load(li) : kEmptyDepth;
-            d[i] = v;
-            if (covered) {
-                lo = std::min(lo, v);
-                hi = std::max(hi, v);
+        auto copy = [&](const raster::ColorBuffer& color, const raster::DepthBuffer& depth,
+                        std::vector<float>& d) {
+            d.resize(pixels);
+            for (size_t i = 0; i < pixels; ++i) {
+                const size_t li = layers.index(l, i);
+                const bool covered = color.load(li).a > 0.0f;
+                const float v = covered ? depth.load(li) : kEmptyDepth;
+                d[i] = v;
+                if (covered) {
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
             }
-        }
+        };
+        copy(layers.color, layers.depth, scratch.depth[l]);
+        if (transparency)
+            copy(layers.transparent_color, layers.transparent_depth, scratch.transparent_depth[l]);
         content_min[l] = lo;
         content_max[l] = hi;
     });
@@ -753,7 +779,16 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             uint32_t level = 0;
             while (level < 16 && float(2u << level) <= side)
                 ++level;
-            buildNBuffer(scratch.depth[l].data(), width, height, level, scratch.nbuffers[l]);
+            if (!transparency) {
+                buildNBuffer(scratch.depth[l].data(), width, height, level, scratch.nbuffers[l]);
+                return;
+            }
+            // One N-buffer for both planes: the nearer of the two depths, so culling stays
+            // lossless for each.
+            std::vector<float> nearest(pixels);
+            for (size_t i = 0; i < pixels; ++i)
+                nearest[i] = std::min(scratch.depth[l][i], scratch.transparent_depth[l][i]);
+            buildNBuffer(nearest.data(), width, height, level, scratch.nbuffers[l]);
         });
         for (uint32_t l = 0; l < m; ++l)
             stats.nbuffer_levels = std::max(stats.nbuffer_levels, scratch.nbuffers[l].levelCount());
@@ -762,6 +797,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
 
     t0 = Clock::now();
     scratch.mips.assign(m, {});
+    scratch.transparent_mips.assign(transparency ? m : 0, {});
     scratch.mip_width.clear();
     scratch.mip_height.clear();
     if (settings.cone) {
@@ -779,17 +815,14 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             scratch.mip_height.push_back(std::max(1u, (scratch.mip_height.back() + 1) / 2));
         }
         stats.mip_levels = levels;
-        pool.parallelFor(m, [&](uint32_t l, uint32_t) {
-            if (tr.segs[l].empty)
-                return;
-            std::vector<std::vector<float>>& mip = scratch.mips[l];
+        // Level 0 from `level0` (premultiplied RGBA per texel), then 2x2 box reductions.
+        auto build = [&](std::vector<std::vector<float>>& mip, auto&& level0) {
             mip.resize(levels);
             mip[0].resize(pixels * 4);
             for (size_t i = 0; i < pixels; ++i) {
-                const glm::vec4 c = layers.color.load(layers.index(l, i));
-                const float a = c.a > 0.0f ? 1.0f : 0.0f;
-                mip[0][i * 4] = c.r * a, mip[0][i * 4 + 1] = c.g * a, mip[0][i * 4 + 2] = c.b * a;
-                mip[0][i * 4 + 3] = a;
+                const glm::vec4 c = level0(i);
+                mip[0][i * 4] = c.r, mip[0][i * 4 + 1] = c.g, mip[0][i * 4 + 2] = c.b;
+                mip[0][i * 4 + 3] = c.a;
             }
             for (uint32_t lv = 1; lv < levels; ++lv) {
                 const uint32_t pw = scratch.mip_width[lv - 1], ph = scratch.mip_height[lv - 1];
@@ -811,6 +844,18 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                                          src[(size_t(y1) * pw + x1) * 4 + c]);
                     }
             }
+        };
+        pool.parallelFor(m, [&](uint32_t l, uint32_t) {
+            if (tr.segs[l].empty)
+                return;
+            build(scratch.mips[l], [&](size_t i) { // coverage alpha: 1 where covered
+                const glm::vec4 c = layers.color.load(layers.index(l, i));
+                const float a = c.a > 0.0f ? 1.0f : 0.0f;
+                return glm::vec4(glm::vec3(c) * a, a);
+            });
+            if (transparency) // already premultiplied, alpha = opacity
+                build(scratch.transparent_mips[l],
+                      [&](size_t i) { return layers.transparent_color.load(layers.index(l, i)); });
         });
     }
     stats.ms_mipmaps = msSince(t0);
@@ -820,6 +865,11 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         for (const std::vector<float>& lv : scratch.mips[l])
             stats.scratch_bytes += lv.size() * sizeof(float);
         stats.scratch_bytes += scratch.depth[l].size() * sizeof(float);
+        if (transparency) {
+            for (const std::vector<float>& lv : scratch.transparent_mips[l])
+                stats.scratch_bytes += lv.size() * sizeof(float);
+            stats.scratch_bytes += scratch.transparent_depth[l].size() * sizeof(float);
+        }
     }
 
     // §4.3: trace every pixel's lens rays, one task per output tile.
@@ -860,6 +910,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         stats.layer_culled_ray += c.culled_ray;
         stats.cone_partial += c.cone_partial;
         stats.texel_fetches += c.fetches;
+        stats.transparent_hits += c.transparent_hits;
     }
     stats.ms_tracing = msSince(t0);
     return stats;

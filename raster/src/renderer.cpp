@@ -154,6 +154,11 @@ Status validate(const LayeredTargetDesc& desc) {
     return {};
 }
 
+bool hasBlendMaterial(const Scene& scene) {
+    return std::any_of(scene.materials.begin(), scene.materials.end(),
+                       [](const Material& m) { return m.alpha_mode == AlphaMode::Blend; });
+}
+
 } // namespace
 
 Status Renderer::render(const Scene& scene, const View& view, const RenderOptions& options,
@@ -172,6 +177,9 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
         out.color[i * 4 + 3] = 1.0f;
     }
     out.depth.resize(options.depth_format, view.width, view.height);
+    const bool transparency = hasBlendMaterial(scene);
+    out.transparent_depth.resize(options.depth_format, transparency ? view.width : 0,
+                                 transparency ? view.height : 0);
     if (options.peel_depth &&
         (options.peel_depth->format != options.depth_format ||
          options.peel_depth->width != view.width || options.peel_depth->height != view.height))
@@ -183,7 +191,9 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
     });
     finishStats(st.tile_counters, msSince(t0), 0.0,
-                out.color.size() * sizeof(float) + out.depth.bytes(), stats);
+                out.color.size() * sizeof(float) + out.depth.bytes() +
+                    out.transparent_depth.bytes(),
+                stats);
     return {};
 }
 
@@ -204,6 +214,11 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     out.color.resize(desc.color_format, pixels * layers, glm::vec4(0.0f));
     out.depth.resize(desc.depth_format, view.width, view.height * layers);
     out.gbuffer.assign(desc.gbuffer ? pixels * layers : 0, GSample{});
+    const bool transparency = hasBlendMaterial(scene);
+    out.transparent_color.resize(desc.color_format, transparency ? pixels * layers : 0,
+                                 glm::vec4(0.0f));
+    out.transparent_depth.resize(desc.depth_format, transparency ? view.width : 0,
+                                 transparency ? view.height * layers : 0);
     std::vector<LayerInterval> intervals(layers);
     for (uint32_t l = 0; l < layers; ++l)
         intervals[l] = overlappedInterval(desc, l);
@@ -218,36 +233,42 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     // Lee et al. §4.2, second pass: copy each covered pixel into every other layer whose
     // overlapped interval holds its depth, with a manual depth test. Pixels stay where the
     // triangle routing put them (the paper's approximation). Reads a per-pixel snapshot, so
-    // the result does not depend on the order of the copies.
+    // the result does not depend on the order of the copies. The transparent planes are copied
+    // the same way (their depth is the nearest BLEND fragment's).
     t0 = std::chrono::steady_clock::now();
     if (desc.routing == LayerRouting::MaxVertexDepth) {
-        pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
-            const TileRect r = tileRect(st.ctx.grid, tile);
-            float snapshot[kMaxLayers];
-            for (uint32_t y = r.y0; y < r.y1; ++y)
-                for (uint32_t x = r.x0; x < r.x1; ++x) {
-                    const size_t p = size_t(y) * view.width + x;
-                    for (uint32_t l = 0; l < layers; ++l)
-                        snapshot[l] = out.depth.load(out.index(l, p));
-                    for (uint32_t src = 0; src < layers; ++src) {
-                        if (!(snapshot[src] < 1.0f))
-                            continue;
-                        const float d = distanceFromDepth(view, snapshot[src]);
-                        for (uint32_t dst = 0; dst < layers; ++dst) {
-                            const size_t di = out.index(dst, p);
-                            if (dst == src || !(d >= intervals[dst].near_d) ||
-                                !(d < intervals[dst].far_d) ||
-                                !(snapshot[src] < out.depth.load(di)))
+        auto copyPass = [&](ColorBuffer& color, DepthBuffer& depth, bool with_gbuffer) {
+            pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
+                const TileRect r = tileRect(st.ctx.grid, tile);
+                float snapshot[kMaxLayers];
+                for (uint32_t y = r.y0; y < r.y1; ++y)
+                    for (uint32_t x = r.x0; x < r.x1; ++x) {
+                        const size_t p = size_t(y) * view.width + x;
+                        for (uint32_t l = 0; l < layers; ++l)
+                            snapshot[l] = depth.load(out.index(l, p));
+                        for (uint32_t src = 0; src < layers; ++src) {
+                            if (!(snapshot[src] < 1.0f))
                                 continue;
-                            const size_t si = out.index(src, p);
-                            out.color.store(di, out.color.load(si));
-                            out.depth.store(di, snapshot[src]);
-                            if (desc.gbuffer)
-                                out.gbuffer[di] = out.gbuffer[si];
+                            const float d = distanceFromDepth(view, snapshot[src]);
+                            for (uint32_t dst = 0; dst < layers; ++dst) {
+                                const size_t di = out.index(dst, p);
+                                if (dst == src || !(d >= intervals[dst].near_d) ||
+                                    !(d < intervals[dst].far_d) ||
+                                    !(snapshot[src] < depth.load(di)))
+                                    continue;
+                                const size_t si = out.index(src, p);
+                                color.store(di, color.load(si));
+                                depth.store(di, snapshot[src]);
+                                if (with_gbuffer)
+                                    out.gbuffer[di] = out.gbuffer[si];
+                            }
                         }
                     }
-                }
-        });
+            });
+        };
+        copyPass(out.color, out.depth, desc.gbuffer);
+        if (transparency)
+            copyPass(out.transparent_color, out.transparent_depth, false);
     }
     finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
     return {};

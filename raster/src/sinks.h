@@ -41,6 +41,8 @@ struct FrameSink {
         dst[0] = c.r, dst[1] = c.g, dst[2] = c.b, dst[3] = c.a;
         if (!f.blend)
             frame.depth.store(pixel, f.z);
+        else if (frame.transparent_depth.quantize(f.z) < frame.transparent_depth.load(pixel))
+            frame.transparent_depth.store(pixel, f.z);
     }
 };
 
@@ -71,8 +73,10 @@ struct LayerSink {
     }
     void writeLayer(uint32_t layer, size_t pixel, const Fragment& f) {
         const size_t i = target.index(layer, pixel);
-        if (f.blend) {
-            target.color.store(i, blendOver(f.color, target.color.load(i)));
+        if (f.blend) { // the transparent plane: over in primitive order, nearest depth
+            target.transparent_color.store(i, blendOver(f.color, target.transparent_color.load(i)));
+            if (target.transparent_depth.quantize(f.z) < target.transparent_depth.load(i))
+                target.transparent_depth.store(i, f.z);
             return;
         }
         target.color.store(i, f.color);

@@ -141,6 +141,7 @@ struct MultiviewStats {
     uint64_t layer_culled_ray = 0;   // (ray, layer) pairs skipped by a query on the ray's path
     uint64_t cone_partial = 0;       // hits whose cone coverage v1 < 1 continued the traversal
     uint64_t texel_fetches = 0;      // height-field lookups
+    uint64_t transparent_hits = 0;   // hits on a layer's transparent plane (BLEND surfaces)
     uint64_t layered_bytes = 0;      // memory of the layered target
     uint64_t scratch_bytes = 0;      // N-buffers + mipmaps
     // Times (not deterministic).
@@ -159,6 +160,10 @@ struct MultiviewScratch {
     // per layer, per level >= 1: premultiplied RGBA (alpha = coverage), level sizes halve
     std::vector<std::vector<std::vector<float>>> mips;
     std::vector<uint32_t> mip_width, mip_height; // per level (level 0 = image)
+    // The same for the layers' transparent planes (empty when the scene has no BLEND surface):
+    // stored D of the nearest BLEND fragment (kEmptyDepth where none) and premultiplied mipmaps.
+    std::vector<std::vector<float>> transparent_depth;
+    std::vector<std::vector<std::vector<float>>> transparent_mips;
 };
 
 // The layered target's description for a depth range (§4.1 spacing + §4.2 options).

@@ -14,6 +14,24 @@ struct Frame {
     uint32_t height = 0;
     std::vector<float> color; // linear RGBA, 4 floats per pixel
     DepthBuffer depth;
+    // Stored D of the nearest BLEND fragment blended over each pixel (1 where none). BLEND
+    // surfaces do not write `depth`, yet they are visible (and get blurred): whatever needs the
+    // visible depths reads both. Sized only when the scene has BLEND materials.
+    DepthBuffer transparent_depth;
 };
+
+// Calls fn(stored D) for every visible surface depth of the frame: the opaque depth and the
+// nearest BLEND surface of each covered pixel (D < 1), in pixel order.
+template <class Fn> void forEachVisibleDepth(const Frame& frame, Fn&& fn) {
+    const size_t pixels = size_t(frame.width) * frame.height;
+    const bool transparent = frame.transparent_depth.bytes() > 0;
+    for (size_t i = 0; i < pixels; ++i) {
+        if (const float d = frame.depth.load(i); d < 1.0f)
+            fn(d);
+        if (transparent)
+            if (const float d = frame.transparent_depth.load(i); d < 1.0f)
+                fn(d);
+    }
+}
 
 } // namespace raster

@@ -57,11 +57,19 @@ struct LayeredTarget {
     DepthBuffer depth;
     // G-buffer (when desc.gbuffer), layer-major: what re-shading a hit needs (Lee et al. §5).
     std::vector<GSample> gbuffer;
+    // The transparent plane of each layer (allocated only when the scene has BLEND materials;
+    // not in the paper, whose layers hold opaque surfaces only): BLEND fragments in front of
+    // the layer's opaque depth, composited with the over operator in primitive order into
+    // premultiplied RGBA (alpha = opacity, 0 = none), and the depth of the nearest of them.
+    ColorBuffer transparent_color;
+    DepthBuffer transparent_depth;
 
     size_t pixelCount() const { return size_t(width) * height; }
     size_t index(uint32_t layer, size_t pixel) const { return layer * pixelCount() + pixel; }
+    bool hasTransparency() const { return transparent_depth.bytes() > 0; }
     size_t bytes() const {
-        return color.bytes() + depth.bytes() + gbuffer.size() * sizeof(GSample);
+        return color.bytes() + depth.bytes() + gbuffer.size() * sizeof(GSample) +
+               transparent_color.bytes() + transparent_depth.bytes();
     }
 };
 

@@ -133,6 +133,15 @@ TEST(Accum, SkipsWhenTheLensCannotChangeTheImage) {
     renderAccum(scene, view, dof::makeThinLens(view, 0.0f, kFocus), makeSamples(16), jitter, 0, {},
                 &stats);
     EXPECT_FALSE(stats.skipped);
+    // A BLEND pane writes no depth but is visible: out of focus in front of an in-focus wall,
+    // it must still be blurred.
+    raster::Scene with_pane = checkerWall(kFocus);
+    const int32_t pane =
+        addMaterial(with_pane, flatMaterial({1.0f, 0.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
+    addQuad(with_pane, -10.0f, -10.0f, 10.0f, 10.0f, kFront, pane);
+    renderAccum(with_pane, view, testLens(view), makeSamples(16), {}, 0, {}, &stats);
+    EXPECT_FALSE(stats.skipped);
+    EXPECT_GT(stats.coc.max_abs_px, 1.0f);
 }
 
 // Radius of a uniform disk from its second moment: E[r^2] = R^2/2, plus the 1/6 px^2 that

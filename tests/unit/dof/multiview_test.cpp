@@ -213,6 +213,30 @@ TEST(Multiview, BoundedThicknessLetsRaysPassBehindThinObjects) {
     EXPECT_LT(e_thin, 0.5 * e_solid) << e_thin << " vs " << e_solid;
 }
 
+TEST(Multiview, TransparentPaneTintsWhatIsBehindIt) {
+    // A 50% red BLEND pane at d = 50 (blurred, C = -12 px) over half of the focused wall: the
+    // layers' transparent planes let rays see the wall through it, tinted as accum tints it.
+    const raster::View view = pixelView(64, 48, 100.0f);
+    raster::Scene scene = wallScene();
+    const int32_t pane =
+        addMaterial(scene, flatMaterial({1.0f, 0.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
+    addQuad(scene, -100.0f, -100.0f, 100.0f, 0.0f, 50.0f, pane); // the lower half of the image
+    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, 100.0f);
+    const dof::LensSampleSet samples = makeSamples(64);
+    const raster::Frame ref = renderAccum(scene, view, lens, samples);
+    const MvRun run = runMultiview(scene, view, lens, samples, exactSettings());
+    EXPECT_NEAR(run.stats.d_near, 50.0f, 1e-3f); // the pane counts as visible depth (§4.1)
+    EXPECT_GT(run.stats.transparent_hits, 0u);
+    raster::Result<dof::ErrorMetrics> e =
+        dof::compareImages({run.frame.color.data(), 64, 48, 4}, {ref.color.data(), 64, 48, 4});
+    ASSERT_TRUE(e.ok());
+    EXPECT_GT(e->psnr_linear_db, 38.0); // measured 45.0 dB
+    // Deep inside the pane (bottom right): 0.5 red + 0.5 * the blue wall.
+    const glm::vec4 c = pixel(run.frame, 56, 44);
+    EXPECT_NEAR(c.r, 0.55f, 0.02f);
+    EXPECT_NEAR(c.b, 0.5f, 0.02f);
+}
+
 TEST(Multiview, BoundInitShortcutSavesLookups) {
     // §4.3: starting the false position from the layer bounds changes few hits and skips the
     // two end lookups wherever the first point lands on content.

@@ -154,6 +154,40 @@ TEST(LayeredTarget, PaperRoutingDiffersOnlyWhereTrianglesCrossBounds) {
     EXPECT_GT(differing, 0u); // the crossing quad does land in other layers
 }
 
+TEST(LayeredTarget, BlendSurfacesGoToTheTransparentPlane) {
+    // A 40% red pane (d = 4) and a 50% blue pane (d = 5) in front of an opaque wall (d = 8), all
+    // in one layer: the opaque plane keeps the wall untouched, the transparent plane holds the
+    // panes composited in primitive order (premultiplied) at the nearer pane's depth.
+    raster::Scene s;
+    addMesh(s, {{-50, -50, -8}, {50, -50, -8}, {50, 50, -8}, {-50, 50, -8}}, {0, 1, 2, 0, 2, 3},
+            addMaterial(s, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f})));
+    addMesh(s, {{-50, -50, -5}, {50, -50, -5}, {50, 50, -5}, {-50, 50, -5}}, {0, 1, 2, 0, 2, 3},
+            addMaterial(s, flatMaterial({0.0f, 0.0f, 1.0f, 0.5f}, AlphaMode::Blend)));
+    addMesh(s, {{-50, -50, -4}, {50, -50, -4}, {50, 50, -4}, {-50, 50, -4}}, {0, 1, 2, 0, 2, 3},
+            addMaterial(s, flatMaterial({1.0f, 0.0f, 0.0f, 0.4f}, AlphaMode::Blend)));
+    const raster::View v = stackView();
+    raster::LayeredTargetDesc desc;
+    desc.bounds = {1.0f, 100.0f};
+    for (LayerRouting routing : {LayerRouting::MaxVertexDepth, LayerRouting::PerFragment}) {
+        desc.routing = routing;
+        const raster::LayeredTarget t = layers(s, v, desc);
+        ASSERT_TRUE(t.hasTransparency());
+        const size_t p = t.index(0, size_t(36) * 96 + 48);
+        const glm::vec4 opaque = t.color.load(p);
+        EXPECT_EQ(opaque, glm::vec4(0.0f, 1.0f, 0.0f, 1.0f));
+        EXPECT_NEAR(raster::distanceFromDepth(v, t.depth.load(p)), 8.0f, 1e-3f);
+        // red over (blue over nothing): rgb = 0.4 red + 0.6 * 0.5 blue, alpha = 1 - 0.6 * 0.5.
+        const glm::vec4 tc = t.transparent_color.load(p);
+        EXPECT_NEAR(tc.r, 0.4f, 1e-6f);
+        EXPECT_NEAR(tc.b, 0.3f, 1e-6f);
+        EXPECT_NEAR(tc.a, 0.7f, 1e-6f);
+        EXPECT_NEAR(raster::distanceFromDepth(v, t.transparent_depth.load(p)), 4.0f, 1e-3f);
+    }
+    // Scenes without BLEND materials get no transparent planes (no memory).
+    EXPECT_FALSE(
+        layers(stackScene(false), v, stackDesc(LayerRouting::PerFragment, 0.1f)).hasTransparency());
+}
+
 TEST(LayeredTarget, BitIdenticalAcrossThreadsAndTiles) {
     const raster::Scene s = stackScene(true);
     const raster::View v = stackView();
