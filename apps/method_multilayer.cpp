@@ -133,6 +133,7 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
                           {"z_far", finite(l.z_far)}});
     }
     out.counts = {{"fragments_collected", st.fragments_collected},
+                  {"fragments_rejected_early", st.fragments_rejected},
                   {"fragments_kept", st.fragments_kept},
                   {"max_list_length", st.max_list_length},
                   {"node_pool_grew", st.node_pool_grew},

@@ -651,6 +651,7 @@ int runRender(const RenderArgs& args) {
         if (!args.dump_fragments.empty()) {
             raster::FragmentListDesc desc;
             desc.max_per_pixel = std::max(desc.max_per_pixel, args.dump_fragment_layers);
+            desc.early_reject = false; // look inside: every fragment, the full list lengths
             desc.color_format = target_color.value_or(desc.color_format);
             desc.depth_format = target_depth.value_or(desc.depth_format);
             raster::FragmentLists lists;

@@ -322,6 +322,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         st.ms_filter = ms_filter;
         st.ms_accumulate = ms_accumulate;
         st.fragments_collected = lists.fragments_collected;
+        st.fragments_rejected = lists.fragments_rejected;
         st.fragments_kept = lists.fragments_kept;
         st.max_list_length = lists.max_list_length;
         st.node_pool_grew = lists.grew;

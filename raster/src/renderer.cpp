@@ -26,6 +26,7 @@ struct Renderer::State {
     std::vector<uint32_t> list_head;
     std::vector<std::vector<FragmentNode>> list_pools;
     std::vector<std::vector<FragmentNode>> sort_scratch;
+    std::vector<float> list_nearest; // ListSink early rejection: k nearest depths per pixel
 };
 
 Renderer::Renderer(TaskPool& pool) : pool_(pool), state_(std::make_unique<State>()) {}
@@ -286,6 +287,11 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     const size_t pixels = size_t(view.width) * view.height;
     st.list_head.assign(pixels, kNoNode);
     st.list_pools.resize(tiles);
+    const uint32_t early_k =
+        desc.early_reject && desc.max_per_pixel > 0 && desc.max_per_pixel <= kMaxEarlyRejectCap
+            ? desc.max_per_pixel
+            : 0;
+    st.list_nearest.assign(pixels * early_k, INFINITY);
     if (st.sort_scratch.size() < pool_.workerCount())
         st.sort_scratch.resize(pool_.workerCount());
 
@@ -293,7 +299,8 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     auto t0 = std::chrono::steady_clock::now();
     pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
         st.list_pools[tile].clear();
-        ListSink sink{st.list_head, st.list_pools[tile]};
+        ListSink sink{st.list_head, st.list_pools[tile],
+                      early_k > 0 ? st.list_nearest.data() : nullptr, early_k};
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
     });
     const double ms_raster = msSince(t0);
@@ -305,6 +312,8 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     out.height = view.height;
     out.desc = desc;
     out.fragments_collected = collected;
+    for (const TileCounters& c : st.tile_counters)
+        out.fragments_rejected += c.rejected;
     out.node_capacity_used = desc.node_capacity;
     if (collected > desc.node_capacity) {
         if (desc.on_overflow == OverflowPolicy::Fail)

@@ -106,16 +106,32 @@ constexpr uint32_t kNoNode = 0xffffffffu;
 
 // Collects into the tile's own node pool (appending at the list head, as an atomic exchange on
 // the GPU does); pools are concatenated in tile order afterwards, so node order is deterministic.
+//
+// Early rejection (when `nearest` is set, for a cap of k fragments per pixel): the sink keeps the
+// k smallest depths written to each pixel so far and rejects, before shading, a fragment at or
+// beyond the k-th. That is exact: fragments reach a pixel in primitive order, so the k earlier
+// ones sort before it by (depth, primitive id) and the resolve would drop it anyway.
 struct ListSink {
     std::vector<uint32_t>& head;     // per pixel: first node (tile-local index) or kNoNode
     std::vector<FragmentNode>& pool; // this tile's nodes
+    float* nearest = nullptr;        // per pixel: k ascending depths (+inf = none yet), or null
+    uint32_t k = 0;
     static constexpr bool wants_gbuffer = false;
 
     void beginTriangle(const SetupTri&) {}
-    bool test(size_t, float, float) const { return true; } // every fragment is collected
+    bool test(size_t pixel, float z, float) const {
+        return !nearest || !(z >= nearest[pixel * k + k - 1]);
+    }
     void write(size_t pixel, const Fragment& f) {
         pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
         head[pixel] = uint32_t(pool.size() - 1);
+        if (nearest) { // insert f.z into the pixel's ascending k depths, dropping the largest
+            float* d = nearest + pixel * k;
+            uint32_t i = k - 1;
+            for (; i > 0 && d[i - 1] > f.z; --i)
+                d[i] = d[i - 1];
+            d[i] = f.z;
+        }
     }
 };
 

@@ -94,8 +94,10 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         frag.z = q.z[l];
         frag.distance = q.distance[l];
         // Early depth test: legal because this tile's owner is the only writer of the pixel.
-        if (!sink.test(idx, frag.z, frag.distance))
+        if (!sink.test(idx, frag.z, frag.distance)) {
+            ++counters.rejected;
             continue;
+        }
         const float b[3] = {q.persp[0][l], q.persp[1][l], q.persp[2][l]};
         const glm::vec4 vcolor =
             tr.has_colors ? b[0] * tr.v[0]->color + b[1] * tr.v[1]->color + b[2] * tr.v[2]->color

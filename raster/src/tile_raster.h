@@ -26,8 +26,9 @@ struct RasterContext {
 };
 
 struct TileCounters {
-    uint64_t covered = 0; // samples inside a triangle
-    uint64_t passed = 0;  // of those, passed the sink's test and the alpha test
+    uint64_t covered = 0;  // samples inside a triangle
+    uint64_t passed = 0;   // of those, passed the sink's test and the alpha test
+    uint64_t rejected = 0; // of those, failed the sink's early test (never shaded)
 };
 
 // A shaded fragment as the output merger sees it.

@@ -74,8 +74,9 @@ struct MultilayerStats {
     double ms_collect = 0.0;          // §4: raster, sort/cap/compact, conversion to level 0
     double ms_filter = 0.0;           // §5: levels 1..n
     double ms_accumulate = 0.0;       // §6.1: traversal and blending
-    uint64_t fragments_collected = 0; // before the N cap
-    uint64_t fragments_kept = 0;      // after it
+    uint64_t fragments_collected = 0; // before the N cap (after early rejection)
+    uint64_t fragments_rejected = 0;  // rejected before shading: N nearer ones already collected
+    uint64_t fragments_kept = 0;      // after the cap
     uint32_t max_list_length = 0;     // longest list before the cap
     bool node_pool_grew = false;
     uint32_t mip_levels = 0;

@@ -26,7 +26,12 @@ struct FragmentListDesc {
     ColorFormat color_format = ColorFormat::Half; // Selgrad et al.: half colour and opacity
     DepthFormat depth_format = DepthFormat::Float32; // and single-precision depth
     OverflowPolicy on_overflow = OverflowPolicy::Grow;
+    // With a cap of at most kMaxEarlyRejectCap, reject (before shading) fragments that already
+    // have N nearer ones in their pixel: the same lists, fewer fragments shaded and sorted. Off:
+    // every fragment is collected, as on the GPU (to inspect the uncapped list lengths).
+    bool early_reject = true;
 };
+constexpr uint32_t kMaxEarlyRejectCap = 16;
 
 struct FragmentLists {
     uint32_t width = 0;
@@ -40,7 +45,8 @@ struct FragmentLists {
     std::vector<uint32_t> list_length; // per pixel: fragments collected before the cap
 
     // Counts from the collection pass.
-    uint64_t fragments_collected = 0; // nodes appended (all fragments)
+    uint64_t fragments_collected = 0; // nodes appended (every fragment without early rejection)
+    uint64_t fragments_rejected = 0;  // rejected early (desc.early_reject), never shaded
     uint64_t fragments_kept = 0;      // after the closest-N cap
     uint32_t max_list_length = 0;     // longest list before the cap
     uint32_t node_capacity_used = 0;  // capacity of the pool that succeeded

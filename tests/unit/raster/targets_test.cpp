@@ -269,7 +269,11 @@ TEST(FragmentLists, CapKeepsTheClosestN) {
     raster::FragmentListDesc two = all;
     two.max_per_pixel = 2;
     const raster::FragmentLists a = lists(s, v, all), b = lists(s, v, two);
-    EXPECT_EQ(a.fragments_collected, b.fragments_collected);
+    // Early rejection skips fragments with two nearer ones already in their pixel (no MASK
+    // here, so every rejected fragment would have been collected).
+    EXPECT_GT(b.fragments_rejected, 0u);
+    EXPECT_EQ(a.fragments_rejected, 0u);
+    EXPECT_EQ(a.fragments_collected, b.fragments_collected + b.fragments_rejected);
     EXPECT_LT(b.fragments_kept, a.fragments_kept);
     for (size_t p = 0; p < size_t(v.width) * v.height; ++p) {
         ASSERT_EQ(b.count(p), std::min(a.count(p), 2u));
@@ -279,6 +283,27 @@ TEST(FragmentLists, CapKeepsTheClosestN) {
         }
         for (uint32_t k = 1; k < a.count(p); ++k) // sorted front to back
             EXPECT_LE(a.depth.load(a.offsets[p] + k - 1), a.depth.load(a.offsets[p] + k));
+    }
+}
+
+TEST(FragmentLists, EarlyRejectionKeepsTheSameListsOnFoliage) {
+    // Alpha-masked leaves many deep: rejecting before shading the fragments that already have N
+    // nearer ones changes no kept fragment (colour, depth, primitive) for any cap.
+    raster::Result<raster::Scene> s = scenes::makeBuiltinScene("foliage");
+    ASSERT_TRUE(s.ok());
+    const raster::View v = raster::viewFromCamera(s->cameras[0], 160, 120);
+    for (uint32_t cap : {1u, 4u, 16u}) {
+        raster::FragmentListDesc early;
+        early.max_per_pixel = cap;
+        raster::FragmentListDesc full = early;
+        full.early_reject = false;
+        const raster::FragmentLists e = lists(*s, v, early), f = lists(*s, v, full);
+        EXPECT_GT(e.fragments_rejected, 0u) << cap;
+        EXPECT_LT(e.fragments_collected, f.fragments_collected) << cap;
+        ASSERT_EQ(e.offsets, f.offsets) << cap;
+        EXPECT_EQ(e.primitive, f.primitive) << cap;
+        EXPECT_EQ(e.color.half, f.color.half) << cap;
+        EXPECT_EQ(e.depth.float32, f.depth.float32) << cap;
     }
 }
 
