@@ -64,6 +64,12 @@ Status validate(const View& view) {
 }
 
 namespace {
+
+bool hasBlendMaterial(const Scene& scene) {
+    return std::any_of(scene.materials.begin(), scene.materials.end(),
+                       [](const Material& m) { return m.alpha_mode == AlphaMode::Blend; });
+}
+
 double msSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
         .count();
@@ -94,6 +100,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.mode = options.shading;
     st.ctx.shade.filter = options.texture_filter;
     st.ctx.kernel = selectQuadKernel(options.simd);
+    st.ctx.blend_last = hasBlendMaterial(scene);
     st.lights = prepareLights(scene, defaultLightDirection(view));
     st.ctx.shade.lights = st.lights.data();
     st.ctx.shade.light_count = uint32_t(st.lights.size());
@@ -153,11 +160,6 @@ Status validate(const LayeredTargetDesc& desc) {
     if (!(desc.overlap >= 0.0f && desc.overlap <= 1.0f))
         return Status::error("layer overlap must be between 0 and 1");
     return {};
-}
-
-bool hasBlendMaterial(const Scene& scene) {
-    return std::any_of(scene.materials.begin(), scene.materials.end(),
-                       [](const Material& m) { return m.alpha_mode == AlphaMode::Blend; });
 }
 
 } // namespace

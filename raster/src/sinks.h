@@ -108,9 +108,9 @@ constexpr uint32_t kNoNode = 0xffffffffu;
 // the GPU does); pools are concatenated in tile order afterwards, so node order is deterministic.
 //
 // Early rejection (when `nearest` is set, for a cap of k fragments per pixel): the sink keeps the
-// k smallest depths written to each pixel so far and rejects, before shading, a fragment at or
-// beyond the k-th. That is exact: fragments reach a pixel in primitive order, so the k earlier
-// ones sort before it by (depth, primitive id) and the resolve would drop it anyway.
+// k smallest depths written to each pixel so far and rejects, before shading, a fragment beyond
+// the k-th. That is exact whatever the arrival order: k fragments strictly nearer sort before it,
+// so the resolve would drop it anyway.
 struct ListSink {
     std::vector<uint32_t>& head;     // per pixel: first node (tile-local index) or kNoNode
     std::vector<FragmentNode>& pool; // this tile's nodes
@@ -120,7 +120,7 @@ struct ListSink {
 
     void beginTriangle(const SetupTri&) {}
     bool test(size_t pixel, float z, float) const {
-        return !nearest || !(z >= nearest[pixel * k + k - 1]);
+        return !nearest || !(z > nearest[pixel * k + k - 1]);
     }
     void write(size_t pixel, const Fragment& f) {
         pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});

@@ -206,13 +206,26 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
     const int32_t tx1 = std::min(tx0 + ts, int32_t(g.width)) - 1;
     const int32_t ty1 = std::min(ty0 + ts, int32_t(g.height)) - 1;
     const GeometryState& geo = *ctx.geometry;
-    for (size_t c = 0; c < geo.chunks.size(); ++c) {
-        const ChunkBins& bins = (*ctx.bins)[c];
-        const GeometryChunk& chunk = geo.chunks[c];
-        for (uint32_t i = bins.offsets[tile]; i < bins.offsets[tile + 1]; ++i)
-            rasterizeTriangle(ctx, chunk, chunk.tris[bins.items[i]], tx0, ty0, tx1, ty1, sink,
-                              counters);
-    }
+    // BLEND triangles go after every OPAQUE and MASK one, as renderers draw them: they write no
+    // depth, so an opaque surface behind a pane drawn later would otherwise overwrite the pane.
+    // Each pass keeps primitive order.
+    auto isBlend = [&](const SetupTri& t) {
+        const Draw& draw = geo.draws[t.draw];
+        const Primitive& prim = ctx.shade.scene->meshes[draw.mesh].primitives[draw.primitive];
+        return materialOf(*ctx.shade.scene, prim).alpha_mode == AlphaMode::Blend;
+    };
+    const int passes = ctx.blend_last ? 2 : 1;
+    for (int pass = 0; pass < passes; ++pass)
+        for (size_t c = 0; c < geo.chunks.size(); ++c) {
+            const ChunkBins& bins = (*ctx.bins)[c];
+            const GeometryChunk& chunk = geo.chunks[c];
+            for (uint32_t i = bins.offsets[tile]; i < bins.offsets[tile + 1]; ++i) {
+                const SetupTri& t = chunk.tris[bins.items[i]];
+                if (ctx.blend_last && isBlend(t) != (pass == 1))
+                    continue;
+                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, sink, counters);
+            }
+        }
 }
 
 template void rasterizeTile<FrameSink>(const RasterContext&, uint32_t, FrameSink&, TileCounters&);

@@ -23,6 +23,7 @@ struct RasterContext {
     TileGrid grid;
     ShadeContext shade;
     QuadKernel kernel = &quadKernelScalar;
+    bool blend_last = false; // the scene has BLEND materials: draw their triangles last
 };
 
 struct TileCounters {

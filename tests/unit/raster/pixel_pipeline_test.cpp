@@ -107,7 +107,7 @@ TEST(Alpha, MaskDiscardsBelowTheCutoffAndIsOpaqueAbove) {
     EXPECT_LT(f.depth.load(32 * kSize + 50), 1.0f);
 }
 
-TEST(Alpha, BlendIsOverInPrimitiveOrderWithoutDepthWrite) {
+TEST(Alpha, BlendIsOverInPrimitiveOrderAfterOpaqueWithoutDepthWrite) {
     raster::Scene s;
     s.background = glm::vec3(0.0f);
     const int32_t a = addMaterial(s, flatMaterial({1, 0, 0, 0.5f}, AlphaMode::Blend));
@@ -115,15 +115,19 @@ TEST(Alpha, BlendIsOverInPrimitiveOrderWithoutDepthWrite) {
     const int32_t opaque = addMaterial(s, flatMaterial({0, 0, 1, 1}));
     addMesh(s, quadAt(50.0f, 20.0f), kQuad, a);
     addMesh(s, quadAt(40.0f, 20.0f), kQuad, b);
-    // An opaque surface behind both, drawn last: blended surfaces wrote no depth, so it covers
-    // them (as on a GPU), except where it is absent.
+    // An opaque surface behind both, submitted last: BLEND triangles are drawn after every
+    // opaque one (they write no depth, so the wall would otherwise cover the panes), then over
+    // each other in primitive order.
     addMesh(s, {{0, -20, -60}, {20, -20, -60}, {20, 20, -60}, {0, 20, -60}}, kQuad, opaque);
     const raster::Frame f = render(s, pixelView(kSize, kSize, kDist));
-    const glm::vec4 left = pixel(f, 20, 32);
+    const glm::vec4 left = pixel(f, 20, 32); // no wall: a over black, then b over that
     EXPECT_FLOAT_EQ(left.r, 0.5f * 0.75f);
     EXPECT_FLOAT_EQ(left.g, 0.25f);
     EXPECT_FLOAT_EQ(left.b, 0.0f);
-    EXPECT_EQ(pixel(f, 40, 32), glm::vec4(0, 0, 1, 1));
+    const glm::vec4 right = pixel(f, 40, 32); // a over the blue wall, then b
+    EXPECT_FLOAT_EQ(right.r, 0.5f * 0.75f);
+    EXPECT_FLOAT_EQ(right.g, 0.25f);
+    EXPECT_FLOAT_EQ(right.b, 0.5f * 0.75f);
 }
 
 // A busy synthetic scene: overlapping opaque, masked and blended triangles of many sizes.
