@@ -70,6 +70,30 @@ raster::Scene wallScene() {
     return scene;
 }
 
+// wallScene() with a green bar [-20, -8] x [-h, h] at d = 50 in front, seen by a 64x48 view
+// (f_px 100) through a lens of aperture E focused on the wall (C(50) = -E px).
+struct BarCase {
+    raster::View view = pixelView(64, 48, 100.0f);
+    raster::Scene scene = wallScene();
+    dof::ThinLens lens;
+    int32_t green = -1; // the bar's material
+};
+BarCase barCase(float half_height, float aperture) {
+    BarCase c;
+    c.green = addMaterial(c.scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
+    addQuad(c.scene, -20.0f, -half_height, -8.0f, half_height, 50.0f, c.green);
+    c.lens = dof::makeThinLens(c.view, aperture, 100.0f);
+    return c;
+}
+
+// Linear PSNR between two frames of one size.
+double psnrDb(const raster::Frame& a, const raster::Frame& b) {
+    raster::Result<dof::ErrorMetrics> e = dof::compareImages(
+        {a.color.data(), a.width, a.height, 4}, {b.color.data(), b.width, b.height, 4});
+    FOCAL_CHECK(e.ok());
+    return e->psnr_linear_db;
+}
+
 TEST(Multiview, InFocusWallIsUnchanged) {
     const raster::View view = pixelView(64, 48, 100.0f);
     const raster::Scene scene = wallScene();
@@ -109,27 +133,19 @@ TEST(Multiview, BlurRadiusMatchesTheLens) {
 TEST(Multiview, ForegroundBlurRevealsHiddenBackground) {
     // A thin near bar in front of the focused wall: the wall behind it shows through (the layers
     // hold the hidden surface, §4.1), so the bar's centre line is mostly wall colour.
-    const raster::View view = pixelView(64, 48, 100.0f);
-    raster::Scene scene = wallScene();
-    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
-    addQuad(scene, -20.0f, -1.0f, -8.0f, 1.0f, 50.0f, green); // 2 px tall at d = 50 -> 4 px
-    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, 100.0f); // C(50) = -12 px
+    const BarCase c = barCase(1.0f, 12.0f); // 2 px tall at d = 50 -> 4 px; C(50) = -12 px
     const dof::LensSampleSet samples = makeSamples(64);
-    const MvRun run = runMultiview(scene, view, lens, samples, exactSettings());
-    const raster::Frame ref = renderAccum(scene, view, lens, samples);
-    const glm::vec4 c = pixel(run.frame, 8, 24), r = pixel(ref, 8, 24);
-    EXPECT_GT(c.r, 0.5f); // mostly the red wall
-    EXPECT_NEAR(c.r, r.r, 0.08f);
-    EXPECT_NEAR(c.g, r.g, 0.08f);
+    const MvRun run = runMultiview(c.scene, c.view, c.lens, samples, exactSettings());
+    const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, samples);
+    const glm::vec4 m = pixel(run.frame, 8, 24), r = pixel(ref, 8, 24);
+    EXPECT_GT(m.r, 0.5f); // mostly the red wall
+    EXPECT_NEAR(m.r, r.r, 0.08f);
+    EXPECT_NEAR(m.g, r.g, 0.08f);
 }
 
 TEST(Multiview, CullingIsLossless) {
-    const raster::View view = pixelView(64, 48, 100.0f);
-    raster::Scene scene = wallScene();
-    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
-    addQuad(scene, -20.0f, -5.0f, -8.0f, 5.0f, 50.0f, green);
-    addQuad(scene, 10.0f, 0.0f, 20.0f, 8.0f, 70.0f, green);
-    const dof::ThinLens lens = dof::makeThinLens(view, 10.0f, 100.0f);
+    BarCase c = barCase(5.0f, 10.0f);
+    addQuad(c.scene, 10.0f, 0.0f, 20.0f, 8.0f, 70.0f, c.green);
     const dof::LensSampleSet samples = makeSamples(24);
     for (dof::Traversal traversal : {dof::Traversal::Scan, dof::Traversal::FalsePosition}) {
         dof::MultiviewSettings on;
@@ -137,8 +153,8 @@ TEST(Multiview, CullingIsLossless) {
         on.traversal = traversal;
         dof::MultiviewSettings off = on;
         off.culling = false;
-        const MvRun a = runMultiview(scene, view, lens, samples, on);
-        const MvRun b = runMultiview(scene, view, lens, samples, off);
+        const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
+        const MvRun b = runMultiview(c.scene, c.view, c.lens, samples, off);
         EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
         EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile, 0u);
         EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
@@ -175,14 +191,8 @@ TEST(Multiview, ScanAndFalsePositionAgreeAndScanIsCloserToAccum) {
     fp.traversal = dof::Traversal::FalsePosition;
     const MvRun a = runMultiview(scene, view, lens, samples, scan);
     const MvRun b = runMultiview(scene, view, lens, samples, fp);
-    auto psnr = [](const raster::Frame& x, const raster::Frame& y) {
-        raster::Result<dof::ErrorMetrics> e =
-            dof::compareImages({x.color.data(), 64, 48, 4}, {y.color.data(), 64, 48, 4});
-        FOCAL_CHECK(e.ok());
-        return e->psnr_linear_db;
-    };
-    EXPECT_GT(psnr(a.frame, b.frame), 30.0);
-    EXPECT_GE(psnr(a.frame, ref), psnr(b.frame, ref) - 0.05);
+    EXPECT_GT(psnrDb(a.frame, b.frame), 30.0);
+    EXPECT_GE(psnrDb(a.frame, ref), psnrDb(b.frame, ref) - 0.05);
     EXPECT_LT(a.stats.texel_fetches, b.stats.texel_fetches); // 1-3 texels per thin layer
 }
 
@@ -190,19 +200,15 @@ TEST(Multiview, BoundedThicknessLetsRaysPassBehindThinObjects) {
     // One deep layer holds a thin bar (d = 50) and the focused wall (d = 100). As a height field
     // the bar is solid down to the wall, so rays of wall pixels beside it that pass behind the
     // bar stop on it (a dark halo); a texel solid over 2 px of CoC lets them through (§4.3).
-    const raster::View view = pixelView(64, 48, 100.0f);
-    raster::Scene scene = wallScene();
-    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
-    addQuad(scene, -20.0f, -1.0f, -8.0f, 1.0f, 50.0f, green);
-    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, 100.0f);
+    const BarCase c = barCase(1.0f, 12.0f);
     const dof::LensSampleSet samples = makeSamples(64);
-    const raster::Frame ref = renderAccum(scene, view, lens, samples);
+    const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, samples);
     dof::MultiviewSettings s = exactSettings();
     s.layers = 1;
     s.thickness_px = INFINITY;
-    const MvRun solid = runMultiview(scene, view, lens, samples, s);
+    const MvRun solid = runMultiview(c.scene, c.view, c.lens, samples, s);
     s.thickness_px = 2.0f;
-    const MvRun thin = runMultiview(scene, view, lens, samples, s);
+    const MvRun thin = runMultiview(c.scene, c.view, c.lens, samples, s);
     // Rows above and below the bar's own image (rows 22-25), inside its blur (|C(50)| = 12 px):
     // wall the centre view sees, which rays passing behind the bar must reach. (Under the bar
     // the wall is hidden and one layer cannot hold it.)
@@ -227,10 +233,7 @@ TEST(Multiview, TransparentPaneTintsWhatIsBehindIt) {
     const MvRun run = runMultiview(scene, view, lens, samples, exactSettings());
     EXPECT_NEAR(run.stats.d_near, 50.0f, 1e-3f); // the pane counts as visible depth (§4.1)
     EXPECT_GT(run.stats.transparent_hits, 0u);
-    raster::Result<dof::ErrorMetrics> e =
-        dof::compareImages({run.frame.color.data(), 64, 48, 4}, {ref.color.data(), 64, 48, 4});
-    ASSERT_TRUE(e.ok());
-    EXPECT_GT(e->psnr_linear_db, 38.0); // measured 45.0 dB
+    EXPECT_GT(psnrDb(run.frame, ref), 38.0); // measured 45.0 dB
     // Deep inside the pane (bottom right): 0.5 red + 0.5 * the blue wall.
     const glm::vec4 c = pixel(run.frame, 56, 44);
     EXPECT_NEAR(c.r, 0.55f, 0.02f);
@@ -240,40 +243,29 @@ TEST(Multiview, TransparentPaneTintsWhatIsBehindIt) {
 TEST(Multiview, BoundInitShortcutSavesLookups) {
     // §4.3: starting the false position from the layer bounds changes few hits and skips the
     // two end lookups wherever the first point lands on content.
-    const raster::View view = pixelView(64, 48, 100.0f);
-    raster::Scene scene = wallScene();
-    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
-    addQuad(scene, -20.0f, -5.0f, -8.0f, 5.0f, 50.0f, green);
-    const dof::ThinLens lens = dof::makeThinLens(view, 10.0f, 100.0f);
+    const BarCase c = barCase(5.0f, 10.0f);
     const dof::LensSampleSet samples = makeSamples(32);
     dof::MultiviewSettings s = exactSettings();
     s.traversal = dof::Traversal::FalsePosition;
-    const MvRun plain = runMultiview(scene, view, lens, samples, s);
+    const MvRun plain = runMultiview(c.scene, c.view, c.lens, samples, s);
     s.bound_init = true;
-    const MvRun shortcut = runMultiview(scene, view, lens, samples, s);
-    raster::Result<dof::ErrorMetrics> e = dof::compareImages(
-        {plain.frame.color.data(), 64, 48, 4}, {shortcut.frame.color.data(), 64, 48, 4});
-    ASSERT_TRUE(e.ok());
-    EXPECT_GT(e->psnr_linear_db, 35.0);
+    const MvRun shortcut = runMultiview(c.scene, c.view, c.lens, samples, s);
+    EXPECT_GT(psnrDb(plain.frame, shortcut.frame), 35.0);
     EXPECT_LT(shortcut.stats.texel_fetches, plain.stats.texel_fetches);
 }
 
 TEST(Multiview, DebugRaysRecordOnePixelWithoutChangingTheImage) {
     // The bar of ForegroundBlurRevealsHiddenBackground: pixel (8, 24) on its centre line sees
     // the bar through some lens points and the wall behind through others (§4.1 hidden layers).
-    const raster::View view = pixelView(64, 48, 100.0f);
-    raster::Scene scene = wallScene();
-    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
-    addQuad(scene, -20.0f, -1.0f, -8.0f, 1.0f, 50.0f, green);
-    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, 100.0f);
+    const BarCase c = barCase(1.0f, 12.0f);
     const dof::LensSampleSet samples = makeSamples(64);
     dof::MultiviewSettings s = exactSettings();
-    const MvRun plain = runMultiview(scene, view, lens, samples, s);
+    const MvRun plain = runMultiview(c.scene, c.view, c.lens, samples, s);
     std::vector<dof::MultiviewRayRecord> rays;
     s.debug_x = 8;
     s.debug_y = 24;
     s.debug_rays = &rays;
-    const MvRun debug = runMultiview(scene, view, lens, samples, s, 2);
+    const MvRun debug = runMultiview(c.scene, c.view, c.lens, samples, s, 2);
     EXPECT_EQ(hashFloats(plain.frame.color), hashFloats(debug.frame.color));
     ASSERT_EQ(rays.size(), samples.size());
     std::vector<uint32_t> per_layer(plain.stats.layers, 0);
@@ -384,22 +376,14 @@ TEST(Multiview, BadSettingsNameTheOption) {
 }
 
 TEST(Multiview, HaltonJitterUsesTheTwoNSequence) {
-    const raster::View view = pixelView(64, 48, 100.0f);
-    raster::Scene scene = wallScene();
-    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
-    addQuad(scene, -20.0f, -5.0f, -8.0f, 5.0f, 50.0f, green);
-    const dof::ThinLens lens = dof::makeThinLens(view, 10.0f, 100.0f);
+    const BarCase c = barCase(5.0f, 10.0f);
     const dof::LensSampleSet samples = makeSamples(16, {}, dof::LensPattern::Halton);
     const dof::LensSampleSet seq = makeSamples(32, {}, dof::LensPattern::Halton);
     dof::MultiviewSettings s;
     s.jitter = dof::JitterMode::Halton;
     s.sequence_2n = &seq;
-    const MvRun run = runMultiview(scene, view, lens, samples, s);
-    const raster::Frame ref = renderAccum(scene, view, lens, makeSamples(256));
-    raster::Result<dof::ErrorMetrics> e =
-        dof::compareImages({run.frame.color.data(), 64, 48, 4}, {ref.color.data(), 64, 48, 4});
-    ASSERT_TRUE(e.ok());
-    EXPECT_GT(e->psnr_linear_db, 25.0);
+    const MvRun run = runMultiview(c.scene, c.view, c.lens, samples, s);
+    EXPECT_GT(psnrDb(run.frame, renderAccum(c.scene, c.view, c.lens, makeSamples(256))), 25.0);
 }
 
 } // namespace
