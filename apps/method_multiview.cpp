@@ -255,6 +255,17 @@ const char* jitterName(dof::JitterMode j) {
     return "?";
 }
 
+// --thickness: a positive number of CoC pixels, or "inf" (the paper's height field).
+std::optional<float> parseThickness(const std::string& text) {
+    if (text == "inf")
+        return INFINITY;
+    char* end = nullptr;
+    const float v = std::strtof(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0.0f))
+        return std::nullopt;
+    return v;
+}
+
 raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, MethodOutput& out) {
     dof::MultiviewSettings s;
     s.layer_spacing_px = a.layer_spacing;
@@ -264,15 +275,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     s.refine_steps = a.refine_steps;
     s.traversal = a.traversal == "scan" ? dof::Traversal::Scan : dof::Traversal::FalsePosition;
     s.bound_init = a.bound_init == "on";
-    if (a.thickness != "inf") {
-        char* end = nullptr;
-        s.thickness_px = std::strtof(a.thickness.c_str(), &end);
-        if (a.thickness.empty() || *end != '\0' || !std::isfinite(s.thickness_px) ||
-            !(s.thickness_px > 0.0f))
-            return raster::Status::error("--thickness must be a positive number of pixels or "
-                                         "inf, got '" +
-                                         a.thickness + "'");
-    }
+    s.thickness_px = parseThickness(a.thickness).value_or(INFINITY); // checked when parsed
     s.cone = a.cone == "on";
     s.culling = a.culling == "on";
     s.jitter = a.jitter == "none"     ? dof::JitterMode::None
@@ -455,7 +458,12 @@ MethodEntry makeMultiviewMethod() {
         cmd.add_option("--thickness", args->thickness,
                        "multiview: with --traversal scan, how far behind its depth a layer texel "
                        "is solid, as a CoC difference in pixels; inf = the paper's height field")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(CLI::Validator(
+                [](std::string& v) -> std::string {
+                    return parseThickness(v) ? "" : "expected a positive number of pixels or inf";
+                },
+                "PX|inf"));
         cmd.add_option("--cone", args->cone, "multiview: approximate cone tracing (Sec. 4.4)")
             ->capture_default_str()
             ->check(CLI::IsMember({"on", "off"}));
