@@ -189,7 +189,12 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
     const bool clamp = tr.settings->offscreen == OffscreenPolicy::Clamp;
     const float c0 = tr.cocOf(s0), c1 = tr.cocOf(s1);
     const float x0 = cx + c0 * w.x, y0 = cy + c0 * w.y;
-    const float dx = (c1 - c0) * w.x, dy = (c1 - c0) * w.y; // image path, u in [0, 1]
+    // Image path, u in [0, 1]. An axis the path moves along by less than kStillPx is treated as
+    // still (at most that much position error), which also keeps 1/|dx| finite.
+    constexpr float kStillPx = 1e-6f;
+    float dx = (c1 - c0) * w.x, dy = (c1 - c0) * w.y;
+    dx = std::fabs(dx) < kStillPx ? 0.0f : dx;
+    dy = std::fabs(dy) < kStillPx ? 0.0f : dy;
     int64_t ix = int64_t(std::floor(x0)), iy = int64_t(std::floor(y0));
     const int64_t step_x = dx > 0.0f ? 1 : -1, step_y = dy > 0.0f ? 1 : -1;
     // u at which the path crosses the next column / row boundary, and per cell.
@@ -200,8 +205,10 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
     float next_y =
         dy != 0.0f ? (dy > 0.0f ? float(iy + 1) - y0 : y0 - float(iy)) * delta_y : INFINITY;
     const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
+    // The path crosses at most |dx| + |dy| + 2 cells; the bound also guards against rounding.
+    const int64_t max_cells = int64_t(std::fabs(dx) + std::fabs(dy)) + 3;
     float u_in = 0.0f;
-    for (;;) {
+    for (int64_t cell = 0; cell < max_cells; ++cell) {
         const float u_out = std::min({next_x, next_y, 1.0f});
         int64_t qx = ix, qy = iy;
         if (clamp)
@@ -224,6 +231,7 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
         else
             iy += step_y, next_y += delta_y;
     }
+    return {};
 }
 
 // Trilinear lookup of a layer's premultiplied coverage mipmap `mip` (§4.4) at image position
