@@ -33,9 +33,11 @@ constexpr float kPi = 3.14159265358979f;
 // Per-layer constants of the traversal, in stored depth D (the ray is a straight line in
 // (x, y, D) because both the image offset C and D are affine in 1/d: Eq. 3 and camera.h).
 struct LayerSeg {
-    float t0 = 0.0f, t1 = 0.0f; // segment bounds in D (overlapped interval, §4.2)
-    float reach_px = 0.0f;      // farthest image offset of any ray in the segment
+    float t0 = 0.0f, t1 = 0.0f;     // segment bounds in D (overlapped interval, §4.2)
+    float own0 = 0.0f, own1 = 0.0f; // the layer's own (not overlapped) interval in D
+    float reach_px = 0.0f;          // farthest image offset of any ray in the segment
     bool empty = true;
+    bool transparent = false; // the transparent plane has content
 };
 
 // One traced ray's result inside a layer.
@@ -179,36 +181,36 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
     return {};
 }
 
-// The exact alternative to the false position that §6 names ("brute-force scanning finds
-// accurate intersection points"): walk every texel the segment's image path crosses (a 2D
-// DDA) and stop in the first one whose surface the ray reaches while inside its column. A texel
-// is solid over [h, h + thickness], so with a bounded thickness a ray that enters a column
-// already behind its surface passes behind it.
+// The alternative to the false position that §6 names ("brute-force scanning finds accurate
+// intersection points"): walk every texel the segment's image path crosses (a 2D DDA) and stop
+// in the first one whose surface the ray reaches while inside its column. A texel is solid over
+// [h, h + thickness], so with a bounded thickness a ray that enters a column already behind its
+// surface passes behind it. The walk stays within the cells of the path's two end points
+// (computed as the per-ray culling box computes them), so culling stays lossless.
 Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
                     float cx, float cy, glm::vec2 w, TileCounters& cnt) {
     const bool clamp = tr.settings->offscreen == OffscreenPolicy::Clamp;
     const float c0 = tr.cocOf(s0), c1 = tr.cocOf(s1);
     const float x0 = cx + c0 * w.x, y0 = cy + c0 * w.y;
-    // Image path, u in [0, 1]. An axis the path moves along by less than kStillPx is treated as
-    // still (at most that much position error), which also keeps 1/|dx| finite.
-    constexpr float kStillPx = 1e-6f;
-    float dx = (c1 - c0) * w.x, dy = (c1 - c0) * w.y;
-    dx = std::fabs(dx) < kStillPx ? 0.0f : dx;
-    dy = std::fabs(dy) < kStillPx ? 0.0f : dy;
+    const float x1 = cx + c1 * w.x, y1 = cy + c1 * w.y;
     int64_t ix = int64_t(std::floor(x0)), iy = int64_t(std::floor(y0));
-    const int64_t step_x = dx > 0.0f ? 1 : -1, step_y = dy > 0.0f ? 1 : -1;
-    // u at which the path crosses the next column / row boundary, and per cell.
-    const float delta_x = dx != 0.0f ? 1.0f / std::fabs(dx) : INFINITY;
-    const float delta_y = dy != 0.0f ? 1.0f / std::fabs(dy) : INFINITY;
-    float next_x =
-        dx != 0.0f ? (dx > 0.0f ? float(ix + 1) - x0 : x0 - float(ix)) * delta_x : INFINITY;
-    float next_y =
-        dy != 0.0f ? (dy > 0.0f ? float(iy + 1) - y0 : y0 - float(iy)) * delta_y : INFINITY;
+    const int64_t end_x = int64_t(std::floor(x1)), end_y = int64_t(std::floor(y1));
+    const int64_t step_x = end_x > ix ? 1 : -1, step_y = end_y > iy ? 1 : -1;
+    // u in [0, 1] along the path at which it crosses the next column / row boundary; an axis
+    // whose end cell is reached is not stepped again.
+    const float dx = x1 - x0, dy = y1 - y0;
+    auto nextX = [&] {
+        return ix == end_x ? INFINITY
+                           : (step_x > 0 ? float(ix + 1) - x0 : x0 - float(ix)) / std::fabs(dx);
+    };
+    auto nextY = [&] {
+        return iy == end_y ? INFINITY
+                           : (step_y > 0 ? float(iy + 1) - y0 : y0 - float(iy)) / std::fabs(dy);
+    };
+    float next_x = nextX(), next_y = nextY();
     const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
-    // The path crosses at most |dx| + |dy| + 2 cells; the bound also guards against rounding.
-    const int64_t max_cells = int64_t(std::fabs(dx) + std::fabs(dy)) + 3;
     float u_in = 0.0f;
-    for (int64_t cell = 0; cell < max_cells; ++cell) {
+    for (;;) {
         const float u_out = std::min({next_x, next_y, 1.0f});
         int64_t qx = ix, qy = iy;
         if (clamp)
@@ -223,15 +225,14 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
             if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d)
                 return {true, std::clamp(h, t_in, t_out), texel};
         }
-        if (u_out >= 1.0f)
+        if (ix == end_x && iy == end_y)
             return {};
-        u_in = u_out;
+        u_in = std::min(u_out, 1.0f);
         if (next_x <= next_y)
-            ix += step_x, next_x += delta_x;
+            ix += step_x, next_x = nextX();
         else
-            iy += step_y, next_y += delta_y;
+            iy += step_y, next_y = nextY();
     }
-    return {};
 }
 
 // Trilinear lookup of a layer's premultiplied coverage mipmap `mip` (§4.4) at image position
@@ -474,17 +475,20 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 }
             }
             ++cnt.layer_tests;
-            auto trace = [&](const std::vector<float>& depth, float s1) {
+            auto trace = [&](const std::vector<float>& depth, float near, float t_a, float t_b) {
                 return s.traversal == Traversal::Scan
-                           ? scanHeightField(tr, depth.data(), seg.t0, s0, s1, cx, cy, w, cnt)
-                           : traceHeightField(tr, depth.data(), seg.t0, s0, s1, cx, cy, w, cnt);
+                           ? scanHeightField(tr, depth.data(), near, t_a, t_b, cx, cy, w, cnt)
+                           : traceHeightField(tr, depth.data(), near, t_a, t_b, cx, cy, w, cnt);
             };
-            const Hit h = trace(tr.scratch->depth[l], seg.t1);
-            if (!tr.scratch->transparent_depth.empty()) {
-                // The layer's transparent plane, in front of its opaque hit: its premultiplied
-                // colour is added and the rest of the ray is seen through (1 - opacity); with
-                // cone tracing both come from its mipmap over the cone's footprint (§4.4).
-                const Hit ht = trace(tr.scratch->transparent_depth[l], h.hit ? h.t : seg.t1);
+            const Hit h = trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
+            // The layer's transparent plane in front of its opaque hit, searched only over the
+            // layer's own interval: a pane in the overlap is in both neighbours' planes and must
+            // be blended once. Its premultiplied colour is added and the rest of the ray is seen
+            // through (1 - opacity); with cone tracing both come from its mipmap (§4.4).
+            const float ta = std::max(s0, seg.own0);
+            const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
+            if (seg.transparent && ta < tb) {
+                const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
                 if (ht.hit) {
                     ++cnt.transparent_hits;
                     const float ct = tr.cocOf(ht.t);
@@ -495,6 +499,9 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                             : lt.transparent_color.load(lt.index(l, ht.texel));
                     color += transmit * glm::vec3(m);
                     transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
+                    t_end = ht.t;
+                    if (rec)
+                        rec->layer = int32_t(l);
                 }
             }
             if (!h.hit)
@@ -723,11 +730,14 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     scratch.transparent_depth.resize(transparency ? m : 0);
     scratch.nbuffers.assign(m, NBuffer{});
     std::vector<float> content_min(m, INFINITY), content_max(m, -INFINITY);
+    std::vector<uint8_t> transparent_content(m, 0);
     pool.parallelFor(m, [&](uint32_t l, uint32_t) {
         float lo = INFINITY, hi = -INFINITY;
+        // Returns whether any texel is covered.
         auto copy = [&](const raster::ColorBuffer& color, const raster::DepthBuffer& depth,
                         std::vector<float>& d) {
             d.resize(pixels);
+            bool any = false;
             for (size_t i = 0; i < pixels; ++i) {
                 const size_t li = layers.index(l, i);
                 const bool covered = color.load(li).a > 0.0f;
@@ -736,12 +746,15 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                 if (covered) {
                     lo = std::min(lo, v);
                     hi = std::max(hi, v);
+                    any = true;
                 }
             }
+            return any;
         };
         copy(layers.color, layers.depth, scratch.depth[l]);
         if (transparency)
-            copy(layers.transparent_color, layers.transparent_depth, scratch.transparent_depth[l]);
+            transparent_content[l] = copy(layers.transparent_color, layers.transparent_depth,
+                                          scratch.transparent_depth[l]);
         content_min[l] = lo;
         content_max[l] = hi;
     });
@@ -765,6 +778,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         }
         seg.t0 = std::clamp(seg.t0, 0.0f, 1.0f);
         seg.t1 = std::clamp(seg.t1, seg.t0, 1.0f);
+        seg.own0 = l == 0 ? seg.t0 : raster::depthFromDistance(view, layers.desc.bounds[l]);
+        seg.own1 = l + 1 == m ? seg.t1 : raster::depthFromDistance(view, layers.desc.bounds[l + 1]);
+        seg.transparent = transparent_content[l] != 0;
         // Every ray of a pixel stays within r_max * max |C| of it over the segment (C is
         // monotonic in D, so the extreme is at an end).
         seg.reach_px =

@@ -26,7 +26,8 @@ struct Renderer::State {
     std::vector<uint32_t> list_head;
     std::vector<std::vector<FragmentNode>> list_pools;
     std::vector<std::vector<FragmentNode>> sort_scratch;
-    std::vector<float> list_nearest; // ListSink early rejection: k nearest depths per pixel
+    // ListSink early rejection: per worker, the k nearest depths of each pixel of its tile.
+    std::vector<std::vector<float>> list_nearest;
 };
 
 Renderer::Renderer(TaskPool& pool) : pool_(pool), state_(std::make_unique<State>()) {}
@@ -236,42 +237,37 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     // Lee et al. §4.2, second pass: copy each covered pixel into every other layer whose
     // overlapped interval holds its depth, with a manual depth test. Pixels stay where the
     // triangle routing put them (the paper's approximation). Reads a per-pixel snapshot, so
-    // the result does not depend on the order of the copies. The transparent planes are copied
-    // the same way (their depth is the nearest BLEND fragment's).
+    // the result does not depend on the order of the copies. (BLEND fragments were routed one
+    // by one to the layer owning their depth, so the transparent planes need no copy.)
     t0 = std::chrono::steady_clock::now();
     if (desc.routing == LayerRouting::MaxVertexDepth) {
-        auto copyPass = [&](ColorBuffer& color, DepthBuffer& depth, bool with_gbuffer) {
-            pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
-                const TileRect r = tileRect(st.ctx.grid, tile);
-                float snapshot[kMaxLayers];
-                for (uint32_t y = r.y0; y < r.y1; ++y)
-                    for (uint32_t x = r.x0; x < r.x1; ++x) {
-                        const size_t p = size_t(y) * view.width + x;
-                        for (uint32_t l = 0; l < layers; ++l)
-                            snapshot[l] = depth.load(out.index(l, p));
-                        for (uint32_t src = 0; src < layers; ++src) {
-                            if (!(snapshot[src] < 1.0f))
+        pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
+            const TileRect r = tileRect(st.ctx.grid, tile);
+            float snapshot[kMaxLayers];
+            for (uint32_t y = r.y0; y < r.y1; ++y)
+                for (uint32_t x = r.x0; x < r.x1; ++x) {
+                    const size_t p = size_t(y) * view.width + x;
+                    for (uint32_t l = 0; l < layers; ++l)
+                        snapshot[l] = out.depth.load(out.index(l, p));
+                    for (uint32_t src = 0; src < layers; ++src) {
+                        if (!(snapshot[src] < 1.0f))
+                            continue;
+                        const float d = distanceFromDepth(view, snapshot[src]);
+                        for (uint32_t dst = 0; dst < layers; ++dst) {
+                            const size_t di = out.index(dst, p);
+                            if (dst == src || !(d >= intervals[dst].near_d) ||
+                                !(d < intervals[dst].far_d) ||
+                                !(snapshot[src] < out.depth.load(di)))
                                 continue;
-                            const float d = distanceFromDepth(view, snapshot[src]);
-                            for (uint32_t dst = 0; dst < layers; ++dst) {
-                                const size_t di = out.index(dst, p);
-                                if (dst == src || !(d >= intervals[dst].near_d) ||
-                                    !(d < intervals[dst].far_d) ||
-                                    !(snapshot[src] < depth.load(di)))
-                                    continue;
-                                const size_t si = out.index(src, p);
-                                color.store(di, color.load(si));
-                                depth.store(di, snapshot[src]);
-                                if (with_gbuffer)
-                                    out.gbuffer[di] = out.gbuffer[si];
-                            }
+                            const size_t si = out.index(src, p);
+                            out.color.store(di, out.color.load(si));
+                            out.depth.store(di, snapshot[src]);
+                            if (desc.gbuffer)
+                                out.gbuffer[di] = out.gbuffer[si];
                         }
                     }
-            });
-        };
-        copyPass(out.color, out.depth, desc.gbuffer);
-        if (transparency)
-            copyPass(out.transparent_color, out.transparent_depth, false);
+                }
+        });
     }
     finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
     return {};
@@ -293,16 +289,25 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         desc.early_reject && desc.max_per_pixel > 0 && desc.max_per_pixel <= kMaxEarlyRejectCap
             ? desc.max_per_pixel
             : 0;
-    st.list_nearest.assign(pixels * early_k, INFINITY);
     if (st.sort_scratch.size() < pool_.workerCount())
         st.sort_scratch.resize(pool_.workerCount());
+    st.list_nearest.resize(pool_.workerCount());
 
     // Collection: every fragment, in primitive order, into its tile's pool.
     auto t0 = std::chrono::steady_clock::now();
-    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
+    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
         st.list_pools[tile].clear();
-        ListSink sink{st.list_head, st.list_pools[tile],
-                      early_k > 0 ? st.list_nearest.data() : nullptr, early_k};
+        ListSink sink{st.list_head, st.list_pools[tile]};
+        if (early_k > 0) {
+            const TileRect r = tileRect(st.ctx.grid, tile);
+            std::vector<float>& nearest = st.list_nearest[worker];
+            nearest.assign(size_t(st.ctx.grid.tile_size) * st.ctx.grid.tile_size * early_k,
+                           INFINITY);
+            sink.nearest = nearest.data();
+            sink.k = early_k;
+            sink.frame_width = view.width;
+            sink.tile_x0 = r.x0, sink.tile_y0 = r.y0, sink.tile_size = st.ctx.grid.tile_size;
+        }
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
     });
     const double ms_raster = msSince(t0);

@@ -29,7 +29,7 @@ struct FrameSink {
     const DepthBuffer* peel = nullptr; // depth peeling: keep only fragments behind this
     static constexpr bool wants_gbuffer = false;
 
-    void beginTriangle(const SetupTri&) {}
+    void beginTriangle(const SetupTri&, bool) {}
     bool test(size_t pixel, float z, float) const {
         const float stored = frame.depth.quantize(z);
         return stored < frame.depth.load(pixel) && (!peel || stored > peel->load(pixel));
@@ -51,9 +51,14 @@ struct LayerSink {
     const std::vector<LayerInterval>& intervals; // overlapped, one per layer
     bool wants_gbuffer = false;
     uint32_t triangle_layer = 0; // MaxVertexDepth routing: the current triangle's layer
+    bool blend_triangle = false;
 
-    void beginTriangle(const SetupTri& t) {
-        if (target.desc.routing == LayerRouting::MaxVertexDepth)
+    // BLEND fragments go, one by one, to the transparent plane of the one layer whose own
+    // (not overlapped) interval holds them: each pane is in exactly one plane, so a ray blends
+    // it once, and no copy pass is needed for those planes.
+    void beginTriangle(const SetupTri& t, bool blend) {
+        blend_triangle = blend;
+        if (!blend && target.desc.routing == LayerRouting::MaxVertexDepth)
             triangle_layer = layerOf(target.desc, t.max_distance);
     }
     bool passes(uint32_t layer, size_t pixel, float z) const {
@@ -64,6 +69,8 @@ struct LayerSink {
         return distance >= intervals[layer].near_d && distance < intervals[layer].far_d;
     }
     bool test(size_t pixel, float z, float distance) const {
+        if (blend_triangle)
+            return passes(layerOf(target.desc, distance), pixel, z);
         if (target.desc.routing == LayerRouting::MaxVertexDepth)
             return passes(triangle_layer, pixel, z);
         for (uint32_t l = 0; l < target.layer_count; ++l)
@@ -85,6 +92,10 @@ struct LayerSink {
             target.gbuffer[i] = f.g;
     }
     void write(size_t pixel, const Fragment& f) {
+        if (f.blend) {
+            writeLayer(layerOf(target.desc, f.distance), pixel, f);
+            return;
+        }
         if (target.desc.routing == LayerRouting::MaxVertexDepth) {
             writeLayer(triangle_layer, pixel, f);
             return;
@@ -114,19 +125,26 @@ constexpr uint32_t kNoNode = 0xffffffffu;
 struct ListSink {
     std::vector<uint32_t>& head;     // per pixel: first node (tile-local index) or kNoNode
     std::vector<FragmentNode>& pool; // this tile's nodes
-    float* nearest = nullptr;        // per pixel: k ascending depths (+inf = none yet), or null
+    // Early rejection: per pixel of the tile (row-major, tile_size wide), k ascending depths
+    // (+inf = none yet); null when off.
+    float* nearest = nullptr;
     uint32_t k = 0;
+    uint32_t frame_width = 0, tile_x0 = 0, tile_y0 = 0, tile_size = 0;
     static constexpr bool wants_gbuffer = false;
 
-    void beginTriangle(const SetupTri&) {}
+    float* nearestOf(size_t pixel) const {
+        const size_t x = pixel % frame_width, y = pixel / frame_width;
+        return nearest + ((y - tile_y0) * tile_size + (x - tile_x0)) * k;
+    }
+    void beginTriangle(const SetupTri&, bool) {}
     bool test(size_t pixel, float z, float) const {
-        return !nearest || !(z > nearest[pixel * k + k - 1]);
+        return !nearest || !(z > nearestOf(pixel)[k - 1]);
     }
     void write(size_t pixel, const Fragment& f) {
         pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
         head[pixel] = uint32_t(pool.size() - 1);
         if (nearest) { // insert f.z into the pixel's ascending k depths, dropping the largest
-            float* d = nearest + pixel * k;
+            float* d = nearestOf(pixel);
             uint32_t i = k - 1;
             for (; i > 0 && d[i - 1] > f.z; --i)
                 d[i] = d[i - 1];

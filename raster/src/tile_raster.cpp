@@ -105,6 +105,10 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         const glm::vec4 base = baseColor(ctx.shade, m, lane_uv[l], vcolor);
         if (m.alpha_mode == AlphaMode::Mask && !(base.a >= m.alpha_cutoff))
             continue;
+        // A BLEND fragment of opacity 0 changes nothing: dropped like a masked one, so it takes
+        // no fragment-list slot and no transparent depth.
+        if (m.alpha_mode == AlphaMode::Blend && !(base.a > 0.0f))
+            continue;
         ++counters.passed;
         const glm::vec3 world =
             b[0] * tr.v[0]->world + b[1] * tr.v[1]->world + b[2] * tr.v[2]->world;
@@ -170,7 +174,7 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     tr.face_normal = glm::cross(tr.v[1]->world - tr.v[0]->world, tr.v[2]->world - tr.v[0]->world);
     if (glm::dot(tr.face_normal, ctx.shade.eye - tr.v[0]->world) < 0.0f)
         tr.face_normal = -tr.face_normal;
-    sink.beginTriangle(t);
+    sink.beginTriangle(t, tr.material->alpha_mode == AlphaMode::Blend);
 
     // Pixel range of this triangle in this tile, widened to whole quad pairs.
     const int32_t x0 = std::max(t.min_x, tile_x0) & ~3, y0 = std::max(t.min_y, tile_y0) & ~1;

@@ -43,7 +43,7 @@ struct Fragment {
 };
 
 // Rasterizes every triangle binned to `tile` and hands the fragments to `sink`.
-// Sink must provide: bool wants_gbuffer; void beginTriangle(const SetupTri&);
+// Sink must provide: bool wants_gbuffer; void beginTriangle(const SetupTri&, bool blend);
 // bool test(size_t pixel, float z, float distance); void write(size_t pixel, const Fragment&).
 template <class Sink>
 void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters);

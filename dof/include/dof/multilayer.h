@@ -77,7 +77,7 @@ struct MultilayerStats {
     uint64_t fragments_collected = 0; // before the N cap (after early rejection)
     uint64_t fragments_rejected = 0;  // rejected before shading: N nearer ones already collected
     uint64_t fragments_kept = 0;      // after the cap
-    uint32_t max_list_length = 0;     // longest list before the cap
+    uint32_t max_list_length = 0; // longest list appended (after early rejection, before the cap)
     bool node_pool_grew = false;
     uint32_t mip_levels = 0;
     uint32_t stack_levels = 0;

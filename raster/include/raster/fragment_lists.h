@@ -42,15 +42,16 @@ struct FragmentLists {
     ColorBuffer color;               // linear RGB + opacity (alpha), one per fragment
     DepthBuffer depth;               // stored depth D, one per fragment (width = count, height = 1)
     std::vector<uint32_t> primitive; // submission index of the fragment's triangle
-    std::vector<uint32_t> list_length; // per pixel: fragments collected before the cap
+    std::vector<uint32_t> list_length; // per pixel: fragments appended (after early
+                                       // rejection, before the cap)
 
     // Counts from the collection pass.
     uint64_t fragments_collected = 0; // nodes appended (every fragment without early rejection)
     uint64_t fragments_rejected = 0;  // rejected early (desc.early_reject), never shaded
     uint64_t fragments_kept = 0;      // after the closest-N cap
-    uint32_t max_list_length = 0;     // longest list before the cap
-    uint32_t node_capacity_used = 0;  // capacity of the pool that succeeded
-    bool grew = false;                // the pool overflowed once and was grown
+    uint32_t max_list_length = 0; // longest list appended (after early rejection, before the cap)
+    uint32_t node_capacity_used = 0; // capacity of the pool that succeeded
+    bool grew = false;               // the pool overflowed once and was grown
 
     uint32_t count(size_t pixel) const { return offsets[pixel + 1] - offsets[pixel]; }
     size_t bytes() const {

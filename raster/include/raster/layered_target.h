@@ -58,9 +58,11 @@ struct LayeredTarget {
     // G-buffer (when desc.gbuffer), layer-major: what re-shading a hit needs (Lee et al. §5).
     std::vector<GSample> gbuffer;
     // The transparent plane of each layer (allocated only when the scene has BLEND materials;
-    // not in the paper, whose layers hold opaque surfaces only): BLEND fragments in front of
-    // the layer's opaque depth, composited with the over operator in primitive order into
-    // premultiplied RGBA (alpha = opacity, 0 = none), and the depth of the nearest of them.
+    // not in the paper, whose layers hold opaque surfaces only): the BLEND fragments whose depth
+    // lies in the layer's own (not overlapped) interval, routed per fragment, that pass its
+    // opaque depth test as drawn (BLEND triangles come after the opaque ones), composited with
+    // the over operator in primitive order into premultiplied RGBA (alpha = opacity, 0 = none),
+    // and the depth of the nearest of them. Each BLEND fragment is in exactly one plane.
     ColorBuffer transparent_color;
     DepthBuffer transparent_depth;
 

@@ -240,6 +240,37 @@ TEST(Multiview, TransparentPaneTintsWhatIsBehindIt) {
     EXPECT_NEAR(c.b, 0.5f, 0.02f);
 }
 
+TEST(Multiview, PanesAcrossLayerBoundsAreBlendedOnce) {
+    // A slanted 50% red BLEND pane over the wall, crossing several layers and their overlaps,
+    // with an almost pinhole lens: multiview must give the pinhole image (each pane fragment
+    // lives in the one layer owning its depth, so no ray blends it twice), and an invisible
+    // pane (opacity 0) in front changes neither the depth range nor the image.
+    const raster::View view = pixelView(64, 48, 100.0f);
+    raster::Scene scene = wallScene();
+    const int32_t red =
+        addMaterial(scene, flatMaterial({1.0f, 0.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
+    addMesh(scene, {{-25, -15, -40}, {25, -15, -90}, {25, 15, -90}, {-25, 15, -40}},
+            {0, 1, 2, 0, 2, 3}, red);
+    const dof::ThinLens lens = dof::makeThinLens(view, 0.01f, 100.0f);
+    const dof::LensSampleSet samples = makeSamples(8);
+    dof::MultiviewSettings s = exactSettings();
+    s.layers = 8;
+    for (raster::LayerRouting routing :
+         {raster::LayerRouting::MaxVertexDepth, raster::LayerRouting::PerFragment}) {
+        s.routing = routing;
+        const MvRun run = runMultiview(scene, view, lens, samples, s);
+        EXPECT_GT(psnrDb(run.frame, render(scene, view)), 60.0) << int(routing);
+    }
+    raster::Scene with_invisible = scene;
+    const int32_t clear = addMaterial(
+        with_invisible, flatMaterial({0.0f, 0.0f, 1.0f, 0.0f}, raster::AlphaMode::Blend));
+    addQuad(with_invisible, -100.0f, -100.0f, 100.0f, 100.0f, 20.0f, clear);
+    const MvRun a = runMultiview(scene, view, lens, samples, s);
+    const MvRun b = runMultiview(with_invisible, view, lens, samples, s);
+    EXPECT_EQ(a.stats.d_near, b.stats.d_near);
+    EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
+}
+
 TEST(Multiview, BoundInitShortcutSavesLookups) {
     // §4.3: starting the false position from the layer bounds changes few hits and skips the
     // two end lookups wherever the first point lands on content.
@@ -280,8 +311,9 @@ TEST(Multiview, DebugRaysRecordOnePixelWithoutChangingTheImage) {
         ++per_layer[size_t(r.layer)];
     }
     // Both the bar's layer and the wall's layer are hit.
-    EXPECT_GE(std::count_if(per_layer.begin(), per_layer.end(), [](uint32_t c) { return c > 0; }),
-              2);
+    EXPECT_GE(
+        std::count_if(per_layer.begin(), per_layer.end(), [](uint32_t hits) { return hits > 0; }),
+        2);
 }
 
 TEST(Multiview, SameBytesForEveryThreadCount) {
