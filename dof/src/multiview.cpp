@@ -196,18 +196,15 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
     int64_t ix = int64_t(std::floor(x0)), iy = int64_t(std::floor(y0));
     const int64_t end_x = int64_t(std::floor(x1)), end_y = int64_t(std::floor(y1));
     const int64_t step_x = end_x > ix ? 1 : -1, step_y = end_y > iy ? 1 : -1;
-    // u in [0, 1] along the path at which it crosses the next column / row boundary; an axis
-    // whose end cell is reached is not stepped again.
-    const float dx = x1 - x0, dy = y1 - y0;
-    auto nextX = [&] {
-        return ix == end_x ? INFINITY
-                           : (step_x > 0 ? float(ix + 1) - x0 : x0 - float(ix)) / std::fabs(dx);
-    };
-    auto nextY = [&] {
-        return iy == end_y ? INFINITY
-                           : (step_y > 0 ? float(iy + 1) - y0 : y0 - float(iy)) / std::fabs(dy);
-    };
-    float next_x = nextX(), next_y = nextY();
+    // u in [0, 1] along the path at which it crosses the next column / row boundary (advanced
+    // by the per-cell step); an axis whose end cell is reached is not stepped again.
+    const float dx = std::fabs(x1 - x0), dy = std::fabs(y1 - y0);
+    const float delta_x = dx > 0.0f ? 1.0f / dx : INFINITY;
+    const float delta_y = dy > 0.0f ? 1.0f / dy : INFINITY;
+    float next_x =
+        ix == end_x ? INFINITY : (step_x > 0 ? float(ix + 1) - x0 : x0 - float(ix)) * delta_x;
+    float next_y =
+        iy == end_y ? INFINITY : (step_y > 0 ? float(iy + 1) - y0 : y0 - float(iy)) * delta_y;
     const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
     float u_in = 0.0f;
     for (;;) {
@@ -228,10 +225,13 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
         if (ix == end_x && iy == end_y)
             return {};
         u_in = std::min(u_out, 1.0f);
-        if (next_x <= next_y)
-            ix += step_x, next_x = nextX();
-        else
-            iy += step_y, next_y = nextY();
+        if (next_x <= next_y) {
+            ix += step_x;
+            next_x = ix == end_x ? INFINITY : next_x + delta_x;
+        } else {
+            iy += step_y;
+            next_y = iy == end_y ? INFINITY : next_y + delta_y;
+        }
     }
 }
 
