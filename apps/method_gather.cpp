@@ -99,6 +99,7 @@ MethodEntry makeGatherMethod() {
     e.summary = "Zhou, Chen & Pullen 2007: two-pass adaptive gather filter on the pinhole colour "
                 "and depth buffer";
     e.add_options = [args](CLI::App& render) {
+        *args = GatherArgs{}; // each new command line starts from the defaults
         render
             .add_option("--gather-max-radius", args->settings.max_radius_px,
                         "gather: largest CoC radius honoured, pixels (1-256); larger CoCs are "

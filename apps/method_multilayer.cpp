@@ -153,6 +153,7 @@ MethodEntry makeMultilayerMethod() {
     e.name = "multilayer";
     e.summary = "Selgrad et al. 2015: filtered per-pixel fragment lists (docs/dof/multilayer.md)";
     e.add_options = [args](CLI::App& render) {
+        *args = MultilayerArgs{}; // each new command line starts from the defaults
         render
             .add_option("--fragments-per-pixel", args->settings.fragments_per_pixel,
                         "multilayer: closest N fragments kept per pixel (§4; 0 = all)")

@@ -426,6 +426,7 @@ MethodEntry makeMultiviewMethod() {
     e.name = "multiview";
     e.summary = "Lee, Eisemann & Seidel 2009: lens rays traced through depth layers";
     e.add_options = [args](CLI::App& cmd) {
+        *args = MultiviewArgs{}; // each new command line starts from the defaults
         cmd.add_option("--layer-spacing", args->layer_spacing,
                        "multiview: CoC growth delta between layers in pixels (Lee Sec. 4.1, "
                        "Eq. 4); the layer count follows (at most 64)")
