@@ -481,10 +481,11 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                            : traceHeightField(tr, depth.data(), near, t_a, t_b, cx, cy, w, cnt);
             };
             const Hit h = trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
-            // The layer's transparent plane in front of its opaque hit, searched only over the
-            // layer's own interval: a pane in the overlap is in both neighbours' planes and must
-            // be blended once. Its premultiplied colour is added and the rest of the ray is seen
-            // through (1 - opacity); with cone tracing both come from its mipmap (§4.4).
+            // The layer's transparent plane in front of its opaque hit. The plane holds only
+            // depths of the layer's own interval (LayerSink routes each BLEND fragment to the
+            // one layer owning its depth), so only that part of the segment is searched. Its
+            // premultiplied colour is added and the rest of the ray is seen through
+            // (1 - opacity); with cone tracing both come from its mipmap (§4.4).
             const float ta = std::max(s0, seg.own0);
             const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
             if (seg.transparent && ta < tb) {

@@ -181,7 +181,7 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
         out.color[i * 4 + 3] = 1.0f;
     }
     out.depth.resize(options.depth_format, view.width, view.height);
-    const bool transparency = hasBlendMaterial(scene);
+    const bool transparency = st.ctx.blend_last; // the scene has BLEND materials
     out.transparent_depth.resize(options.depth_format, transparency ? view.width : 0,
                                  transparency ? view.height : 0);
     if (options.peel_depth &&
@@ -218,7 +218,7 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     out.color.resize(desc.color_format, pixels * layers, glm::vec4(0.0f));
     out.depth.resize(desc.depth_format, view.width, view.height * layers);
     out.gbuffer.assign(desc.gbuffer ? pixels * layers : 0, GSample{});
-    const bool transparency = hasBlendMaterial(scene);
+    const bool transparency = st.ctx.blend_last; // the scene has BLEND materials
     out.transparent_color.resize(desc.color_format, transparency ? pixels * layers : 0,
                                  glm::vec4(0.0f));
     out.transparent_depth.resize(desc.depth_format, transparency ? view.width : 0,
