@@ -33,7 +33,7 @@ struct MultiviewArgs {
     std::string thickness = "2";
     std::string cone = "on";
     std::string culling = "on";
-    std::string jitter = "noise";
+    std::string jitter = "none";
     std::string routing = "max-vertex";
     std::string offscreen = "discard";
     bool view_dependent = false;

@@ -35,7 +35,9 @@ namespace dof {
 // Per-pixel variation of the lens samples (§4.5). Every choice is a pure function of the pixel,
 // the sample index and MultiviewSettings::seed.
 enum class JitterMode : uint8_t {
-    None,   // every pixel uses the shared set (like accum): aliasing along edges
+    None,   // every pixel uses the shared set (like accum): aliasing along edges, which the cones
+            // (§4.4) smooth; the default: closer to accum than Noise on every built-in scene,
+            // in PSNR and SSIM (docs/benchmarks.md)
     Noise,  // the paper's trade-off: a per-pixel 4-component noise texel; its 16 pairwise
             // combinations (n_i, n_j) offset 1/16th of the samples each, scaled by lambda/2
     Halton, // the paper's best quality: a 2N-sample sequence, each pixel takes N consecutive
@@ -107,7 +109,7 @@ struct MultiviewSettings {
     float thickness_px = 2.0f;
     bool culling = true; // §4.3 early layer culling with N-buffers (lossless)
     bool cone = true;    // §4.4 approximate cone tracing
-    JitterMode jitter = JitterMode::Noise;
+    JitterMode jitter = JitterMode::None;
     uint32_t seed = 0; // jitter key
     OffscreenPolicy offscreen = OffscreenPolicy::Discard;
     bool view_dependent = false; // §5: shade each hit from its own lens point (needs G-buffer)
