@@ -33,6 +33,7 @@ struct MultiviewArgs {
     std::string thickness = "2";
     std::string cone = "on";
     std::string culling = "on";
+    std::string precompute_paths = "on";
     std::string jitter = "none";
     std::string routing = "max-vertex";
     std::string offscreen = "discard";
@@ -278,6 +279,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     s.thickness_px = parseThickness(a.thickness).value_or(INFINITY); // checked when parsed
     s.cone = a.cone == "on";
     s.culling = a.culling == "on";
+    s.precompute_paths = a.precompute_paths == "on";
     s.jitter = a.jitter == "none"     ? dof::JitterMode::None
                : a.jitter == "halton" ? dof::JitterMode::Halton
                : a.jitter == "rotate" ? dof::JitterMode::Rotate
@@ -381,6 +383,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"thickness_px", a.thickness},
         {"cone", s.cone},
         {"culling", s.culling},
+        {"precompute_paths", s.precompute_paths},
         {"jitter", jitterName(s.jitter)},
         {"routing", a.routing},
         {"offscreen", a.offscreen},
@@ -408,6 +411,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                   {"cone_partial", st.cone_partial},
                   {"texel_fetches", st.texel_fetches},
                   {"transparent_hits", st.transparent_hits},
+                  {"path_cells", st.path_cells},
                   {"layered_bytes", st.layered_bytes},
                   {"scratch_bytes", st.scratch_bytes}};
     out.stage_ms = {{"pinhole", st.ms_pinhole},
@@ -470,6 +474,11 @@ MethodEntry makeMultiviewMethod() {
             ->check(CLI::IsMember({"on", "off"}));
         cmd.add_option("--culling", args->culling,
                        "multiview: early layer culling with N-buffers (Sec. 4.3)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"on", "off"}));
+        cmd.add_option("--precompute-paths", args->precompute_paths,
+                       "multiview: with --jitter none and the scan, walk each lens ray's path "
+                       "through each layer once per frame, not once per pixel (same image)")
             ->capture_default_str()
             ->check(CLI::IsMember({"on", "off"}));
         cmd.add_option("--jitter", args->jitter,

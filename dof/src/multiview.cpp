@@ -28,6 +28,12 @@ constexpr float kEmptyDepth = 2.0f;
 constexpr float kFullCoverage = 0.999f;
 // Most mip levels built for cone tracing (a 256-pixel cone diameter).
 constexpr uint32_t kMaxMipLevels = 8;
+// Most cells walked in advance (RayPath; 16 bytes each).
+constexpr double kMaxPathCells = double(1u << 22);
+// A path walked in advance is culled per ray only when longer than this: an N-buffer query
+// costs about as much as scanning that many cells (tracing time on demo, dense and foliage at
+// N = 64 with thresholds 0, 4, 8 and never: 8 and never were fastest, 0 slowest by 10-20 %).
+constexpr uint32_t kRayCullMinCells = 8;
 constexpr float kPi = 3.14159265358979f;
 
 // Per-layer constants of the traversal, in stored depth D (the ray is a straight line in
@@ -45,6 +51,22 @@ struct Hit {
     bool hit = false;
     float t = 0.0f;
     uint32_t texel = 0;
+};
+
+// Image positions along a lens ray are kept relative to its pixel's corner (x, y): the ray is
+// at (x, y) + o(t) with o(t) = (0.5, 0.5) + C(t) w (Eq. 2-3). The texel under it is
+// (x + floor(o.x), y + floor(o.y)), so rays of one lens sample cross the same cells relative to
+// their pixels, whatever the pixel: their paths can be walked once per frame (RayPath).
+struct PathCell {
+    int32_t dx = 0, dy = 0;          // texel offset from the pixel
+    float t_in = 0.0f, t_out = 0.0f; // stored D where the ray enters / leaves the texel's column
+};
+
+// The cells one lens ray crosses in a segment [s0, s1] (Tracer::cells[first, first + count)), in
+// order, and their bounding box as offsets (the per-ray culling window).
+struct RayPath {
+    int32_t box_x0 = 0, box_x1 = 0, box_y0 = 0, box_y1 = 0;
+    uint32_t first = 0, count = 0;
 };
 
 struct TileCounters {
@@ -66,12 +88,31 @@ struct Tracer {
     std::vector<LayerSeg> segs;
     uint32_t width = 0, height = 0;
     float coc_a = 0.0f, coc_b = 0.0f; // C(D) = coc_a + coc_b * D
+    // With a shared sample set and the scan (RayPath): path k * segs.size() + l is ray k through
+    // layer l's whole segment; empty otherwise.
+    std::vector<RayPath> paths;
+    std::vector<PathCell> cells;
     float lambda = 0.0f;
     float r_max = 1.0f;           // bound of |v| over every lens position a ray may use
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     glm::vec3 background{0.0f};
 
     float cocOf(float t) const { return coc_a + coc_b * t; }
+    // The ray's offset from its pixel's corner at stored depth t (PathCell).
+    glm::vec2 offsetOf(glm::vec2 w, float t) const {
+        const float c = cocOf(t);
+        return {0.5f + c * w.x, 0.5f + c * w.y};
+    }
+    // The texel at (qx, qy) as OffscreenPolicy says: clamped to the image, or none outside it.
+    std::optional<uint32_t> texelAt(int64_t qx, int64_t qy) const {
+        if (settings->offscreen == OffscreenPolicy::Clamp) {
+            qx = std::clamp<int64_t>(qx, 0, int64_t(width) - 1);
+            qy = std::clamp<int64_t>(qy, 0, int64_t(height) - 1);
+        } else if (qx < 0 || qy < 0 || qx >= int64_t(width) || qy >= int64_t(height)) {
+            return std::nullopt;
+        }
+        return uint32_t(qy) * width + uint32_t(qx);
+    }
 };
 
 float distanceFromD(const raster::View& view, float d_stored) {
@@ -82,9 +123,7 @@ float distanceFromD(const raster::View& view, float d_stored) {
 // stored D per texel) by the method of false position followed by a binary search. The ray's
 // image position at depth t is p + C(t) * w (Eq. 2-3, lens.h), w = (-v.x, v.y).
 Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
-                     float cx, float cy, glm::vec2 w, TileCounters& cnt) {
-    const uint32_t width = tr.width, height = tr.height;
-    const bool clamp = tr.settings->offscreen == OffscreenPolicy::Clamp;
+                     uint32_t x, uint32_t y, glm::vec2 w, TileCounters& cnt) {
     struct Sample {
         float h; // stored D of the texel, or kEmptyDepth
         uint32_t texel;
@@ -92,21 +131,17 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
     };
     auto fetch = [&](float t) -> Sample {
         ++cnt.fetches;
-        const float c = tr.cocOf(t);
-        float px = std::floor(cx + c * w.x), py = std::floor(cy + c * w.y);
-        if (clamp) {
-            px = std::clamp(px, 0.0f, float(width - 1));
-            py = std::clamp(py, 0.0f, float(height - 1));
-        } else if (px < 0.0f || py < 0.0f || px >= float(width) || py >= float(height)) {
+        const glm::vec2 o = tr.offsetOf(w, t);
+        const std::optional<uint32_t> texel = tr.texelAt(int64_t(x) + int64_t(std::floor(o.x)),
+                                                         int64_t(y) + int64_t(std::floor(o.y)));
+        if (!texel)
             return {kEmptyDepth, 0, false};
-        }
-        const uint32_t texel = uint32_t(py) * width + uint32_t(px);
-        const float h = depth[texel];
+        const float h = depth[*texel];
         // Texels beyond the segment's far end count as empty, so N-buffer culling (min > far) is
         // exactly lossless. Texels before the layer's near bound are the near parts of triangles
         // routed here by their farthest vertex (§4.2); the fragment-copy pass put them in their
         // own layer, so here they count as empty too.
-        return {h, texel, h <= s1 && h >= seg_near};
+        return {h, *texel, h <= s1 && h >= seg_near};
     };
     // Signed distance f = t - h along the ray: f < 0 while the ray is in front of the surface.
     // Heights are bound by the layer's extents (§4.3). Empty texels (§4.3, Fig. 5 right) take the
@@ -185,45 +220,32 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
 // intersection points"): walk every texel the segment's image path crosses (a 2D DDA) and stop
 // in the first one whose surface the ray reaches while inside its column. A texel is solid over
 // [h, h + thickness], so with a bounded thickness a ray that enters a column already behind its
-// surface passes behind it. The walk stays within the cells of the path's two end points
-// (computed as the per-ray culling box computes them), so culling stays lossless.
-Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
-                    float cx, float cy, glm::vec2 w, TileCounters& cnt) {
-    const bool clamp = tr.settings->offscreen == OffscreenPolicy::Clamp;
-    const float c0 = tr.cocOf(s0), c1 = tr.cocOf(s1);
-    const float x0 = cx + c0 * w.x, y0 = cy + c0 * w.y;
-    const float x1 = cx + c1 * w.x, y1 = cy + c1 * w.y;
-    int64_t ix = int64_t(std::floor(x0)), iy = int64_t(std::floor(y0));
-    const int64_t end_x = int64_t(std::floor(x1)), end_y = int64_t(std::floor(y1));
+// surface passes behind it.
+//
+// walkCells visits the cells of the path from offset o0 (at s0) to o1 (at s1) in order, as
+// visit(dx, dy, t_in, t_out), until visit returns true. The walk stays within the cells of the
+// two end points, the per-ray culling box, so culling stays lossless.
+template <class Visit>
+void walkCells(glm::vec2 o0, glm::vec2 o1, float s0, float s1, Visit&& visit) {
+    int64_t ix = int64_t(std::floor(o0.x)), iy = int64_t(std::floor(o0.y));
+    const int64_t end_x = int64_t(std::floor(o1.x)), end_y = int64_t(std::floor(o1.y));
     const int64_t step_x = end_x > ix ? 1 : -1, step_y = end_y > iy ? 1 : -1;
     // u in [0, 1] along the path at which it crosses the next column / row boundary (advanced
     // by the per-cell step); an axis whose end cell is reached is not stepped again.
-    const float dx = std::fabs(x1 - x0), dy = std::fabs(y1 - y0);
+    const float dx = std::fabs(o1.x - o0.x), dy = std::fabs(o1.y - o0.y);
     const float delta_x = dx > 0.0f ? 1.0f / dx : INFINITY;
     const float delta_y = dy > 0.0f ? 1.0f / dy : INFINITY;
     float next_x =
-        ix == end_x ? INFINITY : (step_x > 0 ? float(ix + 1) - x0 : x0 - float(ix)) * delta_x;
+        ix == end_x ? INFINITY : (step_x > 0 ? float(ix + 1) - o0.x : o0.x - float(ix)) * delta_x;
     float next_y =
-        iy == end_y ? INFINITY : (step_y > 0 ? float(iy + 1) - y0 : y0 - float(iy)) * delta_y;
-    const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
+        iy == end_y ? INFINITY : (step_y > 0 ? float(iy + 1) - o0.y : o0.y - float(iy)) * delta_y;
     float u_in = 0.0f;
     for (;;) {
         const float u_out = std::min({next_x, next_y, 1.0f});
-        int64_t qx = ix, qy = iy;
-        if (clamp)
-            qx = std::clamp<int64_t>(qx, 0, w_max), qy = std::clamp<int64_t>(qy, 0, h_max);
-        if (qx >= 0 && qy >= 0 && qx <= w_max && qy <= h_max) {
-            ++cnt.fetches;
-            const uint32_t texel = uint32_t(qy) * tr.width + uint32_t(qx);
-            const float h = depth[texel];
-            const float t_in = s0 + u_in * (s1 - s0), t_out = s0 + u_out * (s1 - s0);
-            // Covered as in the false position (texels outside the layer's extent are empty);
-            // the ray reaches the surface inside this column and is not past its thickness.
-            if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d)
-                return {true, std::clamp(h, t_in, t_out), texel};
-        }
+        if (visit(ix, iy, s0 + u_in * (s1 - s0), s0 + u_out * (s1 - s0)))
+            return;
         if (ix == end_x && iy == end_y)
-            return {};
+            return;
         u_in = std::min(u_out, 1.0f);
         if (next_x <= next_y) {
             ix += step_x;
@@ -233,6 +255,46 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
             next_y = iy == end_y ? INFINITY : next_y + delta_y;
         }
     }
+}
+
+// The scan's test of the cell at offset (dx, dy) from pixel (x, y): covered as in the false
+// position (texels outside the layer's extent [seg_near, s1] are empty), the ray reaches the
+// surface inside this column and is not past its thickness.
+bool scanCell(const Tracer& tr, const float* depth, float seg_near, float s1, uint32_t x,
+              uint32_t y, int64_t dx, int64_t dy, float t_in, float t_out, TileCounters& cnt,
+              Hit& hit) {
+    const std::optional<uint32_t> texel = tr.texelAt(int64_t(x) + dx, int64_t(y) + dy);
+    if (!texel)
+        return false;
+    ++cnt.fetches;
+    const float h = depth[*texel];
+    if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d) {
+        hit = {true, std::clamp(h, t_in, t_out), *texel};
+        return true;
+    }
+    return false;
+}
+
+Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
+                    uint32_t x, uint32_t y, glm::vec2 w, TileCounters& cnt) {
+    Hit hit;
+    walkCells(tr.offsetOf(w, s0), tr.offsetOf(w, s1), s0, s1,
+              [&](int64_t dx, int64_t dy, float t_in, float t_out) {
+                  return scanCell(tr, depth, seg_near, s1, x, y, dx, dy, t_in, t_out, cnt, hit);
+              });
+    return hit;
+}
+
+// scanHeightField over a path walked in advance (the same cells, so the same result).
+Hit scanPath(const Tracer& tr, const float* depth, float seg_near, float s1, uint32_t x, uint32_t y,
+             const RayPath& path, TileCounters& cnt) {
+    Hit hit;
+    for (uint32_t i = path.first; i < path.first + path.count; ++i) {
+        const PathCell& c = tr.cells[i];
+        if (scanCell(tr, depth, seg_near, s1, x, y, c.dx, c.dy, c.t_in, c.t_out, cnt, hit))
+            break;
+    }
+    return hit;
 }
 
 // Trilinear lookup of a layer's premultiplied coverage mipmap `mip` (§4.4) at image position
@@ -247,19 +309,23 @@ glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mi
     const float f = level - float(l0);
     auto bilinear = [&](uint32_t lv) {
         const std::vector<float>& img = mip[lv];
-        const uint32_t w = sc.mip_width[lv], h = sc.mip_height[lv];
+        const int64_t w = sc.mip_width[lv], h = sc.mip_height[lv];
         const float scale = 1.0f / float(1u << lv);
         const float u = px * scale - 0.5f, v = py * scale - 0.5f;
         const float fu = std::floor(u), fv = std::floor(v);
         const float au = u - fu, av = v - fv;
-        auto at = [&](float x, float y) {
-            const uint32_t xi = uint32_t(std::clamp(x, 0.0f, float(w - 1)));
-            const uint32_t yi = uint32_t(std::clamp(y, 0.0f, float(h - 1)));
-            const float* p = img.data() + (size_t(yi) * w + xi) * 4;
+        // The four texels, clamped to the level (fu, fv are within a few texels of it).
+        const int64_t x0 = std::clamp<int64_t>(int64_t(fu), 0, w - 1);
+        const int64_t x1 = std::clamp<int64_t>(int64_t(fu) + 1, 0, w - 1);
+        const float* r0 = img.data() + size_t(std::clamp<int64_t>(int64_t(fv), 0, h - 1) * w) * 4;
+        const float* r1 =
+            img.data() + size_t(std::clamp<int64_t>(int64_t(fv) + 1, 0, h - 1) * w) * 4;
+        auto at = [](const float* row, int64_t x) {
+            const float* p = row + x * 4;
             return glm::vec4(p[0], p[1], p[2], p[3]);
         };
-        const glm::vec4 top_row = at(fu, fv) * (1.0f - au) + at(fu + 1.0f, fv) * au;
-        const glm::vec4 bottom = at(fu, fv + 1.0f) * (1.0f - au) + at(fu + 1.0f, fv + 1.0f) * au;
+        const glm::vec4 top_row = at(r0, x0) * (1.0f - au) + at(r0, x1) * au;
+        const glm::vec4 bottom = at(r1, x0) * (1.0f - au) + at(r1, x1) * au;
         return top_row * (1.0f - av) + bottom * av;
     };
     const glm::vec4 c0 = bilinear(l0);
@@ -378,16 +444,31 @@ bool culled(const Tracer& tr, uint32_t l, float x_lo, float x_hi, float y_lo, fl
     return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > seg.t1;
 }
 
-// Whether layer l has no texel within its segment in the image box [x_lo, x_hi] x [y_lo, y_hi]
-// (positions, clamped to the image as OffscreenPolicy::Clamp reads them).
-bool boxCulled(const Tracer& tr, uint32_t l, float x_lo, float x_hi, float y_lo, float y_hi) {
-    auto clampi = [](float v, int64_t hi) {
-        return std::clamp<int64_t>(int64_t(std::floor(v)), 0, hi);
-    };
-    const int64_t x0 = clampi(x_lo, tr.width - 1), x1 = clampi(x_hi, tr.width - 1);
-    const int64_t y0 = clampi(y_lo, tr.height - 1), y1 = clampi(y_hi, tr.height - 1);
+// Whether layer l has no texel within its segment in the texel box [x0, x1] x [y0, y1]
+// (clamped to the image, as OffscreenPolicy::Clamp reads it).
+bool boxCulled(const Tracer& tr, uint32_t l, int64_t x0, int64_t x1, int64_t y0, int64_t y1) {
+    const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
+    x0 = std::clamp<int64_t>(x0, 0, w_max), x1 = std::clamp<int64_t>(x1, 0, w_max);
+    y0 = std::clamp<int64_t>(y0, 0, h_max), y1 = std::clamp<int64_t>(y1, 0, h_max);
     const int64_t size = std::max(x1 - x0, y1 - y0) + 1;
     return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > tr.segs[l].t1;
+}
+
+// The path of ray direction w through [s0, s1]: its cells appended to `cells`.
+RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<PathCell>& cells) {
+    RayPath p;
+    const glm::vec2 o0 = tr.offsetOf(w, s0), o1 = tr.offsetOf(w, s1);
+    p.box_x0 = int32_t(std::floor(std::min(o0.x, o1.x)));
+    p.box_x1 = int32_t(std::floor(std::max(o0.x, o1.x)));
+    p.box_y0 = int32_t(std::floor(std::min(o0.y, o1.y)));
+    p.box_y1 = int32_t(std::floor(std::max(o0.y, o1.y)));
+    p.first = uint32_t(cells.size());
+    walkCells(o0, o1, s0, s1, [&](int64_t dx, int64_t dy, float t_in, float t_out) {
+        cells.push_back({int32_t(dx), int32_t(dy), t_in, t_out});
+        return false;
+    });
+    p.count = uint32_t(cells.size()) - p.first;
+    return p;
 }
 
 void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_layers,
@@ -428,11 +509,13 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
         ++cnt.rays;
         const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
         const glm::vec2 w(-ls.position.x, ls.position.y); // lensRayImageOffset per unit C
-        auto inside = [&](float t) {
-            const float c = tr.cocOf(t);
-            const float px = cx + c * w.x, py = cy + c * w.y;
-            return px >= 0.0f && py >= 0.0f && px < float(tr.width) && py < float(tr.height);
+        auto inside = [&](float t) {                      // (x, y) + o(t) lies in the image
+            const glm::vec2 o = tr.offsetOf(w, t);
+            return o.x >= -float(x) && o.y >= -float(y) && o.x < float(tr.width - x) &&
+                   o.y < float(tr.height - y);
         };
+        // This ray's paths walked in advance, when every pixel shares the sample set.
+        const RayPath* paths = tr.paths.empty() ? nullptr : &tr.paths[size_t(k) * tr.segs.size()];
         const bool discard = s.offscreen == OffscreenPolicy::Discard;
         MultiviewRayRecord* rec = records ? &(*records)[k] : nullptr;
         if (rec) {
@@ -460,16 +543,26 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             const float s0 = std::max(seg.t0, t_resume);
             if (!(s0 < seg.t1))
                 continue;
-            if (s.culling) {
+            // The whole segment's path walked in advance, unless the ray resumes inside it.
+            const RayPath* path = paths && s0 == seg.t0 ? &paths[l] : nullptr;
+            if (s.culling && (!path || path->count > kRayCullMinCells)) {
                 // Per-ray culling: the texels this ray's segment can read lie in the box of its
                 // end points; one N-buffer query skips the height-field test when none of them
                 // is within the layer (the same test as §4.3's per-pixel culling, on a smaller
-                // window, so it is just as lossless).
-                const float c0 = tr.cocOf(s0), c1e = tr.cocOf(seg.t1);
-                const float xa = cx + c0 * w.x, xb = cx + c1e * w.x;
-                const float ya = cy + c0 * w.y, yb = cy + c1e * w.y;
-                if (boxCulled(tr, l, std::min(xa, xb), std::max(xa, xb), std::min(ya, yb),
-                              std::max(ya, yb))) {
+                // window, so it is just as lossless). Short paths walked in advance are
+                // scanned without it.
+                int64_t x0, x1, y0, y1;
+                if (path) {
+                    x0 = path->box_x0, x1 = path->box_x1, y0 = path->box_y0, y1 = path->box_y1;
+                } else {
+                    const glm::vec2 oa = tr.offsetOf(w, s0), ob = tr.offsetOf(w, seg.t1);
+                    x0 = int64_t(std::floor(std::min(oa.x, ob.x)));
+                    x1 = int64_t(std::floor(std::max(oa.x, ob.x)));
+                    y0 = int64_t(std::floor(std::min(oa.y, ob.y)));
+                    y1 = int64_t(std::floor(std::max(oa.y, ob.y)));
+                }
+                if (boxCulled(tr, l, int64_t(x) + x0, int64_t(x) + x1, int64_t(y) + y0,
+                              int64_t(y) + y1)) {
                     ++cnt.culled_ray;
                     continue;
                 }
@@ -477,10 +570,12 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             ++cnt.layer_tests;
             auto trace = [&](const std::vector<float>& depth, float near, float t_a, float t_b) {
                 return s.traversal == Traversal::Scan
-                           ? scanHeightField(tr, depth.data(), near, t_a, t_b, cx, cy, w, cnt)
-                           : traceHeightField(tr, depth.data(), near, t_a, t_b, cx, cy, w, cnt);
+                           ? scanHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt)
+                           : traceHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt);
             };
-            const Hit h = trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
+            const Hit h =
+                path ? scanPath(tr, tr.scratch->depth[l].data(), seg.t0, seg.t1, x, y, *path, cnt)
+                     : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
             // The layer's transparent plane in front of its opaque hit. The plane holds only
             // depths of the layer's own interval (LayerSink routes each BLEND fragment to the
             // one layer owning its depth), so only that part of the segment is searched. Its
@@ -899,6 +994,26 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
 
     // §4.3: trace every pixel's lens rays, one task per output tile.
     t0 = Clock::now();
+    if (settings.precompute_paths && settings.jitter == JitterMode::None &&
+        settings.traversal == Traversal::Scan) {
+        // A path crosses at most |dx| + |dy| + 1 cells; walk them in advance unless the lens
+        // makes that absurdly many (the per-pixel walk is then the cheaper one).
+        double cells_bound = 0.0;
+        for (const LayerSeg& seg : tr.segs)
+            cells_bound += 2.0 * double(tr.r_max) *
+                               std::fabs(double(tr.cocOf(seg.t1)) - double(tr.cocOf(seg.t0))) +
+                           2.0;
+        if (cells_bound * samples.size() <= double(kMaxPathCells)) {
+            tr.paths.reserve(size_t(samples.size()) * m);
+            for (uint32_t k = 0; k < samples.size(); ++k) {
+                const glm::vec2 p = samples.sample(k).position;
+                for (uint32_t l = 0; l < m; ++l)
+                    tr.paths.push_back(
+                        walkPath(tr, glm::vec2(-p.x, p.y), tr.segs[l].t0, tr.segs[l].t1, tr.cells));
+            }
+            stats.path_cells = tr.cells.size();
+        }
+    }
     rgba.assign(pixels * 4, 0.0f);
     const uint32_t ts = settings.tile_size;
     const uint32_t tiles_x = (width + ts - 1) / ts, tiles_y = (height + ts - 1) / ts;

@@ -108,7 +108,11 @@ struct MultiviewSettings {
     // layer's far end, so a ray passing behind a thin object in the same layer stops on it.
     float thickness_px = 2.0f;
     bool culling = true; // §4.3 early layer culling with N-buffers (lossless)
-    bool cone = true;    // §4.4 approximate cone tracing
+    // With JitterMode::None and Traversal::Scan every pixel's ray k crosses the same cells
+    // relative to the pixel, so each (sample, layer) path is walked once per frame instead of
+    // once per pixel. The same bits either way; off is the per-pixel reference.
+    bool precompute_paths = true;
+    bool cone = true; // §4.4 approximate cone tracing
     JitterMode jitter = JitterMode::None;
     uint32_t seed = 0; // jitter key
     OffscreenPolicy offscreen = OffscreenPolicy::Discard;
@@ -144,6 +148,7 @@ struct MultiviewStats {
     uint64_t cone_partial = 0;       // hits whose cone coverage v1 < 1 continued the traversal
     uint64_t texel_fetches = 0;      // height-field lookups
     uint64_t transparent_hits = 0;   // hits on a layer's transparent plane (BLEND surfaces)
+    uint64_t path_cells = 0;         // cells of the paths walked once per frame (0: none)
     uint64_t layered_bytes = 0;      // memory of the layered target
     uint64_t scratch_bytes = 0;      // N-buffers + mipmaps
     // Times (not deterministic).
