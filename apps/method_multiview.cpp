@@ -36,7 +36,7 @@ struct MultiviewArgs {
     std::string precompute_paths = "on";
     std::string jitter = "none";
     std::string routing = "max-vertex";
-    std::string offscreen = "discard";
+    std::string offscreen = "clamp";
     bool view_dependent = false;
     std::string cone_shading = "footprint";
     std::string env_map;
@@ -491,8 +491,10 @@ MethodEntry makeMultiviewMethod() {
                        "per-fragment (exact)")
             ->capture_default_str()
             ->check(CLI::IsMember({"max-vertex", "per-fragment"}));
-        cmd.add_option("--offscreen", args->offscreen,
-                       "multiview: rays leaving the image: discard (the paper) or clamp")
+        cmd.add_option(
+               "--offscreen", args->offscreen,
+               "multiview: rays leaving the image: clamp (read the border texels) or discard (the "
+               "paper)")
             ->capture_default_str()
             ->check(CLI::IsMember({"discard", "clamp"}));
         cmd.add_flag("--view-dependent", args->view_dependent,

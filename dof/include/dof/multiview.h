@@ -54,7 +54,8 @@ enum class Traversal : uint8_t {
 // What happens to a lens ray whose path leaves the image (§4.3 "Handling Off-Screen Pixels").
 enum class OffscreenPolicy : uint8_t {
     Discard, // the paper: the ray is dropped and the remaining rays' weights renormalised
-    Clamp,   // the ray reads the nearest border texel instead
+    Clamp,   // the ray reads the nearest border texel instead; the default: closer to accum
+             // than Discard on every built-in scene, in PSNR and SSIM (docs/benchmarks.md)
 };
 
 // How a cone hit (§4.4) is shaded when hits are re-shaded per ray (§5). The paper mipmaps the
@@ -115,7 +116,7 @@ struct MultiviewSettings {
     bool cone = true; // §4.4 approximate cone tracing
     JitterMode jitter = JitterMode::None;
     uint32_t seed = 0; // jitter key
-    OffscreenPolicy offscreen = OffscreenPolicy::Discard;
+    OffscreenPolicy offscreen = OffscreenPolicy::Clamp;
     bool view_dependent = false; // §5: shade each hit from its own lens point (needs G-buffer)
     ConeShading cone_shading = ConeShading::Footprint; // with cone && (view_dependent || env)
     const EnvironmentMap* env_map = nullptr;           // §5 reflections (implies a G-buffer)

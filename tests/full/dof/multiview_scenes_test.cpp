@@ -2,7 +2,8 @@
 // reduced size: the background behind the railing's thin near bars shows through (§4.1 hidden
 // layers, Fig. 8 first row), the crossing branches of Fig. 8 (second row) come out as accum
 // renders them, alpha-blended panes stay visible (transparent planes), and per-ray shading (§5)
-// beats view-independent shading on shiny spheres; the default jitter is the closer one.
+// beats view-independent shading on shiny spheres; the defaults that differ from the paper are
+// the closer ones.
 #include "../../unit/dof/dof_test_util.h"
 #include "support/builtin_case.h"
 
@@ -97,19 +98,26 @@ TEST(MultiviewScenes, GlassPanesShowThroughTransparentPlanes) {
     EXPECT_GT(e.psnr_linear_db, compare(pinhole.color, ref).psnr_linear_db + 4.0);
 }
 
-TEST(MultiviewScenes, DefaultJitterIsCloserToTheReferenceThanNoise) {
-    // §4.5's noise jitter trades the shared pattern's aliasing for per-pixel noise; with the cones
-    // smoothing the pattern's copies, the shared pattern (the default) is closer to accum in both
-    // metrics (on all eight scenes at 800x600, N = 32 and 64: docs/benchmarks.md).
+TEST(MultiviewScenes, DefaultsAreCloserToTheReferenceThanThePapersChoices) {
+    // Two defaults differ from the paper, because they are closer to accum in both metrics on all
+    // eight scenes at 800x600 (docs/benchmarks.md): the shared sample set instead of §4.5's noise
+    // jitter (the cones already smooth the pattern's copies), and clamping rays that leave the
+    // image to its border instead of discarding them (§4.3), which biases the periphery.
     const BuiltinCase c = loadBuiltinCase("foliage", 320, 240);
     const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, makeSamples(256), {}, 2);
-    ASSERT_EQ(dof::MultiviewSettings{}.jitter, dof::JitterMode::None);
+    const dof::MultiviewSettings defaults;
+    ASSERT_EQ(defaults.jitter, dof::JitterMode::None);
+    ASSERT_EQ(defaults.offscreen, dof::OffscreenPolicy::Clamp);
     dof::MultiviewSettings noise;
     noise.jitter = dof::JitterMode::Noise;
-    const dof::ErrorMetrics shared = compare(multiview(c, makeSamples(32), {}), ref);
-    const dof::ErrorMetrics jittered = compare(multiview(c, makeSamples(32), noise), ref);
-    EXPECT_GT(shared.psnr_linear_db, jittered.psnr_linear_db);
-    EXPECT_GT(shared.ssim, jittered.ssim);
+    dof::MultiviewSettings discard;
+    discard.offscreen = dof::OffscreenPolicy::Discard;
+    const dof::ErrorMetrics d = compare(multiview(c, makeSamples(32), defaults), ref);
+    for (const dof::MultiviewSettings& paper : {noise, discard}) {
+        const dof::ErrorMetrics p = compare(multiview(c, makeSamples(32), paper), ref);
+        EXPECT_GT(d.psnr_linear_db, p.psnr_linear_db);
+        EXPECT_GT(d.ssim, p.ssim);
+    }
 }
 
 TEST(MultiviewScenes, ViewDependentShadingBeatsViewIndependent) {
