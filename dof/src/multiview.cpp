@@ -30,6 +30,9 @@ constexpr float kFullCoverage = 0.999f;
 constexpr uint32_t kMaxMipLevels = 8;
 // Most cells walked in advance (RayPath; 16 bytes each).
 constexpr double kMaxPathCells = double(1u << 22);
+// Largest image offset a ray may reach (pixels): beyond it the lens is rejected as absurd for the
+// view (offsets are then still exact in float and fit RayPath's int32 boxes).
+constexpr float kMaxReachPx = float(1u << 24);
 // A path walked in advance is culled per ray only when longer than this: an N-buffer query
 // costs about as much as scanning that many cells (tracing time on demo, dense and foliage at
 // N = 64 with thresholds 0, 4, 8 and never: 8 and never were fastest, 0 slowest by 10-20 %).
@@ -121,7 +124,8 @@ float distanceFromD(const raster::View& view, float d_stored) {
 
 // §4.3 "Ray Traversal": the lens ray's segment [s0, s1] in one height field (`depth`, a layer's
 // stored D per texel) by the method of false position followed by a binary search. The ray's
-// image position at depth t is p + C(t) * w (Eq. 2-3, lens.h), w = (-v.x, v.y).
+// image position at depth t is p + C(t) * w (Eq. 2-3, lens.h), w = (-v.x, v.y), kept relative to
+// pixel (x, y) as Tracer::offsetOf.
 Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
                      uint32_t x, uint32_t y, glm::vec2 w, TileCounters& cnt) {
     struct Sample {
@@ -314,12 +318,14 @@ glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mi
         const float u = px * scale - 0.5f, v = py * scale - 0.5f;
         const float fu = std::floor(u), fv = std::floor(v);
         const float au = u - fu, av = v - fv;
-        // The four texels, clamped to the level (fu, fv are within a few texels of it).
-        const int64_t x0 = std::clamp<int64_t>(int64_t(fu), 0, w - 1);
-        const int64_t x1 = std::clamp<int64_t>(int64_t(fu) + 1, 0, w - 1);
-        const float* r0 = img.data() + size_t(std::clamp<int64_t>(int64_t(fv), 0, h - 1) * w) * 4;
-        const float* r1 =
-            img.data() + size_t(std::clamp<int64_t>(int64_t(fv) + 1, 0, h - 1) * w) * 4;
+        // The four texels, clamped to the level (the position may lie far outside it when a
+        // clamped ray read a border texel).
+        const int64_t iu = int64_t(std::clamp(fu, -1.0f, float(w)));
+        const int64_t iv = int64_t(std::clamp(fv, -1.0f, float(h)));
+        const int64_t x0 = std::clamp<int64_t>(iu, 0, w - 1);
+        const int64_t x1 = std::clamp<int64_t>(iu + 1, 0, w - 1);
+        const float* r0 = img.data() + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * 4;
+        const float* r1 = img.data() + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * 4;
         auto at = [](const float* row, int64_t x) {
             const float* p = row + x * 4;
             return glm::vec4(p[0], p[1], p[2], p[3]);
@@ -429,23 +435,9 @@ LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
     return tr.samples->sample(k);
 }
 
-// Square window (texel range) any ray of a pixel region can read in layer l, clamped to the
-// image, as an N-buffer query. Returns true when the layer can be skipped (§4.3 early culling:
-// the minimum depth in the window is beyond the layer's far bound).
-bool culled(const Tracer& tr, uint32_t l, float x_lo, float x_hi, float y_lo, float y_hi) {
-    const LayerSeg& seg = tr.segs[l];
-    const float r = seg.reach_px;
-    auto clampi = [](float v, int64_t hi) {
-        return std::clamp<int64_t>(int64_t(std::floor(v)), 0, hi);
-    };
-    const int64_t x0 = clampi(x_lo - r, tr.width - 1), x1 = clampi(x_hi + r, tr.width - 1);
-    const int64_t y0 = clampi(y_lo - r, tr.height - 1), y1 = clampi(y_hi + r, tr.height - 1);
-    const int64_t size = std::max(x1 - x0, y1 - y0) + 1;
-    return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > seg.t1;
-}
-
 // Whether layer l has no texel within its segment in the texel box [x0, x1] x [y0, y1]
-// (clamped to the image, as OffscreenPolicy::Clamp reads it).
+// (clamped to the image, as OffscreenPolicy::Clamp reads it): one N-buffer query, §4.3 early
+// culling (the minimum depth in the window is beyond the layer's far bound).
 bool boxCulled(const Tracer& tr, uint32_t l, int64_t x0, int64_t x1, int64_t y0, int64_t y1) {
     const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
     x0 = std::clamp<int64_t>(x0, 0, w_max), x1 = std::clamp<int64_t>(x1, 0, w_max);
@@ -454,14 +446,31 @@ bool boxCulled(const Tracer& tr, uint32_t l, int64_t x0, int64_t x1, int64_t y0,
     return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > tr.segs[l].t1;
 }
 
+// Whether layer l can be skipped for every ray of the pixels [x0, x1] x [y0, y1]: a ray stays
+// within reach_px of its pixel centre in the layer, so it reads texel offsets within
+// [floor(0.5 - reach), floor(0.5 + reach)] of its pixel (PathCell).
+bool culled(const Tracer& tr, uint32_t l, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1) {
+    const float r = tr.segs[l].reach_px;
+    const int64_t lo = int64_t(std::floor(0.5f - r)), hi = int64_t(std::floor(0.5f + r));
+    return boxCulled(tr, l, int64_t(x0) + lo, int64_t(x1) + hi, int64_t(y0) + lo, int64_t(y1) + hi);
+}
+
+// The cells a path from offset o0 to o1 can cross lie in the box of its end cells.
+struct CellBox {
+    int64_t x0, x1, y0, y1;
+};
+CellBox cellBox(glm::vec2 o0, glm::vec2 o1) {
+    return {int64_t(std::floor(std::min(o0.x, o1.x))), int64_t(std::floor(std::max(o0.x, o1.x))),
+            int64_t(std::floor(std::min(o0.y, o1.y))), int64_t(std::floor(std::max(o0.y, o1.y)))};
+}
+
 // The path of ray direction w through [s0, s1]: its cells appended to `cells`.
 RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<PathCell>& cells) {
     RayPath p;
     const glm::vec2 o0 = tr.offsetOf(w, s0), o1 = tr.offsetOf(w, s1);
-    p.box_x0 = int32_t(std::floor(std::min(o0.x, o1.x)));
-    p.box_x1 = int32_t(std::floor(std::max(o0.x, o1.x)));
-    p.box_y0 = int32_t(std::floor(std::min(o0.y, o1.y)));
-    p.box_y1 = int32_t(std::floor(std::max(o0.y, o1.y)));
+    const CellBox box = cellBox(o0, o1); // |offsets| < kMaxReachPx: int32 holds them
+    p.box_x0 = int32_t(box.x0), p.box_x1 = int32_t(box.x1);
+    p.box_y0 = int32_t(box.y0), p.box_y1 = int32_t(box.y1);
     p.first = uint32_t(cells.size());
     walkCells(o0, o1, s0, s1, [&](int64_t dx, int64_t dy, float t_in, float t_out) {
         cells.push_back({int32_t(dx), int32_t(dy), t_in, t_out});
@@ -480,7 +489,7 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
     uint32_t active_count = 0;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
         const uint32_t l = tile_layers[i];
-        if (s.culling && culled(tr, l, cx, cx, cy, cy)) {
+        if (s.culling && culled(tr, l, x, x, y, y)) {
             ++cnt.culled_pixel;
             continue;
         }
@@ -551,18 +560,11 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 // is within the layer (the same test as §4.3's per-pixel culling, on a smaller
                 // window, so it is just as lossless). Short paths walked in advance are
                 // scanned without it.
-                int64_t x0, x1, y0, y1;
-                if (path) {
-                    x0 = path->box_x0, x1 = path->box_x1, y0 = path->box_y0, y1 = path->box_y1;
-                } else {
-                    const glm::vec2 oa = tr.offsetOf(w, s0), ob = tr.offsetOf(w, seg.t1);
-                    x0 = int64_t(std::floor(std::min(oa.x, ob.x)));
-                    x1 = int64_t(std::floor(std::max(oa.x, ob.x)));
-                    y0 = int64_t(std::floor(std::min(oa.y, ob.y)));
-                    y1 = int64_t(std::floor(std::max(oa.y, ob.y)));
-                }
-                if (boxCulled(tr, l, int64_t(x) + x0, int64_t(x) + x1, int64_t(y) + y0,
-                              int64_t(y) + y1)) {
+                const CellBox box =
+                    path ? CellBox{path->box_x0, path->box_x1, path->box_y0, path->box_y1}
+                         : cellBox(tr.offsetOf(w, s0), tr.offsetOf(w, seg.t1));
+                if (boxCulled(tr, l, int64_t(x) + box.x0, int64_t(x) + box.x1, int64_t(y) + box.y0,
+                              int64_t(y) + box.y1)) {
                     ++cnt.culled_ray;
                     continue;
                 }
@@ -881,6 +883,10 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         // monotonic in D, so the extreme is at an end).
         seg.reach_px =
             tr.r_max * std::max(std::fabs(tr.cocOf(seg.t0)), std::fabs(tr.cocOf(seg.t1)));
+        if (!(seg.reach_px < kMaxReachPx))
+            return Status::error("multiview: the lens blurs by more than 2^24 pixels over the "
+                                 "visible depths (aperture radius " +
+                                 std::to_string(lens.aperture_radius) + ")");
         if (!seg.empty)
             reach_max = std::max(reach_max, seg.reach_px);
         else
@@ -996,8 +1002,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     t0 = Clock::now();
     if (settings.precompute_paths && settings.jitter == JitterMode::None &&
         settings.traversal == Traversal::Scan) {
-        // A path crosses at most |dx| + |dy| + 1 cells; walk them in advance unless the lens
-        // makes that absurdly many (the per-pixel walk is then the cheaper one).
+        // A path crosses about |dx| + |dy| + 1 cells (estimated as 2 per pixel of offset, plus
+        // 2); walk them in advance unless the lens makes that very many (the per-pixel walk is
+        // then the cheaper one).
         double cells_bound = 0.0;
         for (const LayerSeg& seg : tr.segs)
             cells_bound += 2.0 * double(tr.r_max) *
@@ -1008,8 +1015,10 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             for (uint32_t k = 0; k < samples.size(); ++k) {
                 const glm::vec2 p = samples.sample(k).position;
                 for (uint32_t l = 0; l < m; ++l)
-                    tr.paths.push_back(
-                        walkPath(tr, glm::vec2(-p.x, p.y), tr.segs[l].t0, tr.segs[l].t1, tr.cells));
+                    tr.paths.push_back(tr.segs[l].empty // never traced
+                                           ? RayPath{}
+                                           : walkPath(tr, glm::vec2(-p.x, p.y), tr.segs[l].t0,
+                                                      tr.segs[l].t1, tr.cells));
             }
             stats.path_cells = tr.cells.size();
         }
@@ -1028,8 +1037,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         for (uint32_t l = 0; l < m; ++l) {
             if (tr.segs[l].empty)
                 continue;
-            if (settings.culling && culled(tr, l, float(x0) + 0.5f, float(x1) - 0.5f,
-                                           float(y0) + 0.5f, float(y1) - 0.5f)) {
+            if (settings.culling && culled(tr, l, x0, x1 - 1, y0, y1 - 1)) {
                 ++cnt.culled_tile;
                 continue;
             }

@@ -147,18 +147,20 @@ TEST(Multiview, CullingIsLossless) {
     BarCase c = barCase(5.0f, 10.0f);
     addQuad(c.scene, 10.0f, 0.0f, 20.0f, 8.0f, 70.0f, c.green);
     const dof::LensSampleSet samples = makeSamples(24);
-    for (dof::Traversal traversal : {dof::Traversal::Scan, dof::Traversal::FalsePosition}) {
-        dof::MultiviewSettings on;
-        on.layer_spacing_px = 1.0f;
-        on.traversal = traversal;
-        dof::MultiviewSettings off = on;
-        off.culling = false;
-        const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
-        const MvRun b = runMultiview(c.scene, c.view, c.lens, samples, off);
-        EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
-        EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile, 0u);
-        EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
-    }
+    for (dof::Traversal traversal : {dof::Traversal::Scan, dof::Traversal::FalsePosition})
+        for (dof::JitterMode jitter : {dof::JitterMode::None, dof::JitterMode::Noise}) {
+            dof::MultiviewSettings on;
+            on.layer_spacing_px = 1.0f;
+            on.traversal = traversal;
+            on.jitter = jitter; // per-pixel samples: every path is walked per pixel
+            dof::MultiviewSettings off = on;
+            off.culling = false;
+            const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
+            const MvRun b = runMultiview(c.scene, c.view, c.lens, samples, off);
+            EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
+            EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile, 0u);
+            EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
+        }
 }
 
 TEST(Multiview, PrecomputedPathsGiveTheSameBytes) {
@@ -190,6 +192,15 @@ TEST(Multiview, PrecomputedPathsGiveTheSameBytes) {
             EXPECT_GT(a.stats.cone_partial, 0u);
             EXPECT_GT(a.stats.transparent_hits, 0u);
             EXPECT_EQ(a.stats.rays_discarded, b.stats.rays_discarded);
+            if (offscreen == dof::OffscreenPolicy::Discard) {
+                EXPECT_GT(a.stats.rays_discarded, 0u);
+            }
+            // Short precomputed paths skip the per-ray query; the two-layer paths are long
+            // enough to keep it.
+            EXPECT_LT(a.stats.layer_culled_ray, b.stats.layer_culled_ray);
+            if (layers == 2) {
+                EXPECT_GT(a.stats.layer_culled_ray, 0u);
+            }
         }
     dof::MultiviewSettings noise;
     noise.jitter = dof::JitterMode::Noise; // per-pixel samples: nothing to share
@@ -363,12 +374,14 @@ TEST(Multiview, SameBytesForEveryThreadCount) {
     hex.kind = dof::ApertureKind::Polygon;
     hex.blades = 6;
     const dof::LensSampleSet samples = makeSamples(24, hex, dof::LensPattern::Poisson, 3);
-    for (dof::JitterMode j : {dof::JitterMode::Noise, dof::JitterMode::Rotate}) {
+    for (dof::JitterMode j :
+         {dof::JitterMode::None, dof::JitterMode::Noise, dof::JitterMode::Rotate}) {
         dof::MultiviewSettings s;
         s.jitter = j;
-        // Both traversals (the false position with the bound shortcut).
+        // Both traversals (the false position with the bound shortcut); None is the default,
+        // with the paths walked once per frame.
         s.traversal =
-            j == dof::JitterMode::Noise ? dof::Traversal::Scan : dof::Traversal::FalsePosition;
+            j == dof::JitterMode::Rotate ? dof::Traversal::FalsePosition : dof::Traversal::Scan;
         s.bound_init = true;
         s.view_dependent = true;
         s.tile_size = 8;
@@ -410,6 +423,30 @@ TEST(Multiview, BothRoutingPoliciesAndOffscreenPoliciesRun) {
                 EXPECT_EQ(run.stats.rays_discarded, 0u);
             }
         }
+}
+
+TEST(Multiview, AbsurdBlurIsAnErrorNotACrash) {
+    // A lens whose circle of confusion spans more than 2^24 pixels over the visible depths.
+    BarCase c = barCase(5.0f, 1e9f);
+    raster::TaskPool pool(0);
+    raster::Renderer renderer(pool);
+    raster::RenderOptions options;
+    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
+        return renderer.render(c.scene, v, options, f);
+    };
+    const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
+                                  raster::LayeredTarget& t) {
+        return renderer.renderLayers(c.scene, v, options, d, t);
+    };
+    dof::ShadingInputs shading;
+    shading.scene = &c.scene;
+    std::vector<float> rgba;
+    dof::MultiviewSettings s;
+    s.layers = 4;
+    const raster::Result<dof::MultiviewStats> r = dof::renderMultiview(
+        c.view, c.lens, makeSamples(8), s, shading, c.scene.background, pin, lay, pool, rgba);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find("2^24 pixels"), std::string::npos) << r.status().message();
 }
 
 TEST(Multiview, BadSettingsNameTheOption) {
