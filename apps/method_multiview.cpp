@@ -349,6 +349,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
             s.debug_y = dy;
         }
         s.debug_rays = &debug_rays;
+        s.skip_unblurred = false; // the pictures show every stage, even for a sharp image
     }
     dof::ShadingInputs shading;
     shading.scene = &in.scene;
@@ -384,6 +385,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"cone", s.cone},
         {"culling", s.culling},
         {"precompute_paths", s.precompute_paths},
+        {"skip_unblurred", s.skip_unblurred},
         {"jitter", jitterName(s.jitter)},
         {"routing", a.routing},
         {"offscreen", a.offscreen},
@@ -393,7 +395,12 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"env_intensity", a.env_intensity},
         {"layer_color", s.color_format == raster::ColorFormat::Half ? "half" : "float32"},
         {"layer_depth", s.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"}};
-    out.counts = {{"layers", st.layers},
+    if (st.skipped)
+        std::fprintf(stderr, "focal: note: multiview rendered the pinhole only: %s\n",
+                     st.skip_reason.c_str());
+    out.counts = {{"skipped", st.skipped},
+                  {"skip_reason", st.skip_reason},
+                  {"layers", st.layers},
                   {"layers_empty", st.layers_empty},
                   {"budget_limited", st.budget_limited},
                   {"d_near", st.d_near},

@@ -1082,9 +1082,28 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
         return st;
     const double ms_pinhole = msSince(t0);
     const DepthRange range = visibleDepthRange(pinhole, view);
-    if (!range.covered) { // nothing to blur: the image is the background
+    // Nothing to blur: the pinhole render is the result (the same rule as accum's, so both
+    // methods return the pinhole image for the same lenses). Rays offset by less than half a
+    // pixel would read every pixel's own texel anyway.
+    std::string skip_reason;
+    if (!range.covered) {
+        skip_reason = "nothing visible: the image is the background";
+    } else if (settings.skip_unblurred && !settings.env_map) {
+        const CocRange coc = visibleCocRange(lens, pinhole, view);
+        if (lens.aperture_radius == 0.0f) {
+            skip_reason = "aperture radius is 0 (pinhole)";
+        } else if (coc.max_abs_px < 0.5f) {
+            char buf[96];
+            std::snprintf(buf, sizeof buf, "every visible depth has |C(d)| < 0.5 px (max %.3f px)",
+                          double(coc.max_abs_px));
+            skip_reason = buf;
+        }
+    }
+    if (!skip_reason.empty()) {
         rgba = pinhole.color;
         MultiviewStats stats;
+        stats.skipped = true;
+        stats.skip_reason = std::move(skip_reason);
         stats.ms_pinhole = ms_pinhole;
         return stats;
     }

@@ -113,6 +113,9 @@ struct MultiviewSettings {
     // relative to the pixel, so each (sample, layer) path is walked once per frame instead of
     // once per pixel. The same bits either way; off is the per-pixel reference.
     bool precompute_paths = true;
+    // Return the pinhole render when the lens cannot change the image (MultiviewStats::skipped);
+    // false runs every stage anyway (for looking at them).
+    bool skip_unblurred = true;
     bool cone = true; // §4.4 approximate cone tracing
     JitterMode jitter = JitterMode::None;
     uint32_t seed = 0; // jitter key
@@ -130,6 +133,11 @@ struct MultiviewSettings {
 };
 
 struct MultiviewStats {
+    // The lens cannot change the image (as accum decides it: aperture 0, or every visible depth
+    // has |C(d)| < 0.5 px; or nothing is visible), so the pinhole render is the result. Not with
+    // an environment map (its reflections need the synthesis) or skip_unblurred off.
+    bool skipped = false;
+    std::string skip_reason;
     // Counts (deterministic).
     uint32_t layers = 0;               // M
     uint32_t layers_empty = 0;         // layers with no fragment (skipped entirely)

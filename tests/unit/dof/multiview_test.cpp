@@ -102,7 +102,9 @@ TEST(Multiview, InFocusWallIsUnchanged) {
     for (dof::JitterMode j : {dof::JitterMode::None, dof::JitterMode::Noise}) {
         dof::MultiviewSettings s;
         s.jitter = j;
+        s.skip_unblurred = false; // run every stage (the default returns the pinhole)
         const MvRun run = runMultiview(scene, view, lens, samples, s);
+        ASSERT_FALSE(run.stats.skipped);
         const raster::Frame pin = render(scene, view);
         for (size_t i = 0; i < pin.color.size(); ++i)
             ASSERT_NEAR(run.frame.color[i], pin.color[i], 1e-3f) << "float " << i;
@@ -300,6 +302,7 @@ TEST(Multiview, PanesAcrossLayerBoundsAreBlendedOnce) {
     const dof::ThinLens lens = dof::makeThinLens(view, 0.01f, 100.0f);
     const dof::LensSampleSet samples = makeSamples(8);
     dof::MultiviewSettings s = exactSettings();
+    s.skip_unblurred = false; // |C| < 0.5 px: run the synthesis anyway
     s.layers = 8;
     for (raster::LayerRouting routing :
          {raster::LayerRouting::MaxVertexDepth, raster::LayerRouting::PerFragment}) {
@@ -423,6 +426,31 @@ TEST(Multiview, BothRoutingPoliciesAndOffscreenPoliciesRun) {
                 EXPECT_EQ(run.stats.rays_discarded, 0u);
             }
         }
+}
+
+TEST(Multiview, UnblurredLensReturnsThePinholeAndSaysWhy) {
+    // As accum: with no aperture, or every visible |C| below half a pixel, the lens cannot change
+    // the image; the pinhole render is returned as it is.
+    BarCase c = barCase(5.0f, 0.0f);
+    const raster::Frame pin = render(c.scene, c.view);
+    const dof::LensSampleSet samples = makeSamples(16);
+    const MvRun zero = runMultiview(c.scene, c.view, c.lens, samples, {});
+    EXPECT_TRUE(zero.stats.skipped);
+    EXPECT_NE(zero.stats.skip_reason.find("aperture radius is 0"), std::string::npos);
+    EXPECT_EQ(hashFloats(zero.frame.color), hashFloats(pin.color));
+    EXPECT_EQ(zero.stats.rays, 0u);
+    c.lens = dof::makeThinLens(c.view, 0.4f, 100.0f); // |C(50)| = 0.4 px
+    const MvRun sharp = runMultiview(c.scene, c.view, c.lens, samples, {});
+    EXPECT_TRUE(sharp.stats.skipped);
+    EXPECT_NE(sharp.stats.skip_reason.find("< 0.5 px"), std::string::npos);
+    EXPECT_EQ(hashFloats(sharp.frame.color), hashFloats(pin.color));
+    dof::MultiviewSettings all;
+    all.skip_unblurred = false;
+    const MvRun synthesized = runMultiview(c.scene, c.view, c.lens, samples, all);
+    EXPECT_FALSE(synthesized.stats.skipped);
+    EXPECT_GT(synthesized.stats.rays, 0u);
+    c.lens = dof::makeThinLens(c.view, 0.6f, 100.0f); // |C(50)| = 0.6 px: a blur
+    EXPECT_FALSE(runMultiview(c.scene, c.view, c.lens, samples, {}).stats.skipped);
 }
 
 TEST(Multiview, AbsurdBlurIsAnErrorNotACrash) {
