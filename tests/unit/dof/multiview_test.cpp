@@ -18,13 +18,14 @@ struct MvRun {
     dof::MultiviewStats stats;
 };
 
-MvRun runMultiview(const raster::Scene& scene, const raster::View& view, const dof::ThinLens& lens,
-                   const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings,
-                   uint32_t threads = 0) {
+// renderMultiview with a plain renderer; `run` gets the image and the pinhole depth.
+raster::Result<dof::MultiviewStats>
+tryMultiview(const raster::Scene& scene, const raster::View& view, const dof::ThinLens& lens,
+             const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings,
+             uint32_t threads, MvRun& run) {
     raster::TaskPool pool(threads);
     raster::Renderer renderer(pool);
     raster::RenderOptions options;
-    MvRun run;
     const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
         return renderer.render(scene, v, options, f);
     };
@@ -37,9 +38,18 @@ MvRun runMultiview(const raster::Scene& scene, const raster::View& view, const d
     std::vector<float> rgba;
     raster::Result<dof::MultiviewStats> r = dof::renderMultiview(
         view, lens, samples, settings, shading, scene.background, pin, lay, pool, rgba, &run.frame);
+    run.frame.color = rgba;
+    return r;
+}
+
+MvRun runMultiview(const raster::Scene& scene, const raster::View& view, const dof::ThinLens& lens,
+                   const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings,
+                   uint32_t threads = 0) {
+    MvRun run;
+    raster::Result<dof::MultiviewStats> r =
+        tryMultiview(scene, view, lens, samples, settings, threads, run);
     FOCAL_CHECK(r.ok());
     run.stats = *r;
-    run.frame.color = rgba;
     return run;
 }
 
@@ -456,23 +466,11 @@ TEST(Multiview, UnblurredLensReturnsThePinholeAndSaysWhy) {
 TEST(Multiview, AbsurdBlurIsAnErrorNotACrash) {
     // A lens whose circle of confusion spans more than 2^24 pixels over the visible depths.
     BarCase c = barCase(5.0f, 1e9f);
-    raster::TaskPool pool(0);
-    raster::Renderer renderer(pool);
-    raster::RenderOptions options;
-    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
-        return renderer.render(c.scene, v, options, f);
-    };
-    const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                  raster::LayeredTarget& t) {
-        return renderer.renderLayers(c.scene, v, options, d, t);
-    };
-    dof::ShadingInputs shading;
-    shading.scene = &c.scene;
-    std::vector<float> rgba;
     dof::MultiviewSettings s;
     s.layers = 4;
-    const raster::Result<dof::MultiviewStats> r = dof::renderMultiview(
-        c.view, c.lens, makeSamples(8), s, shading, c.scene.background, pin, lay, pool, rgba);
+    MvRun run;
+    const raster::Result<dof::MultiviewStats> r =
+        tryMultiview(c.scene, c.view, c.lens, makeSamples(8), s, 0, run);
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.status().message().find("2^24 pixels"), std::string::npos) << r.status().message();
 }
