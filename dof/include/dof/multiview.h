@@ -2,8 +2,9 @@
 // (Lee, Eisemann & Seidel 2009). Consumes a pinhole frame and a raster::LayeredTarget rendered
 // through the lens centre (§4.1-4.2; or render callbacks that produce them), the thin lens and a
 // lens sample set; traces N lens rays per pixel through the layers' height fields (§4.3, Eq. 2-3)
-// with N-buffer culling (§4.3), approximate cone tracing (§4.4), jittered lens sampling (§4.5)
-// and optional view-dependent shading per ray (§5). Produces linear RGBA owned by the caller;
+// with N-buffer culling (§4.3), approximate cone tracing (§4.4), optional jittered lens
+// sampling (§4.5; the shared set is the default) and optional view-dependent shading per ray
+// (§5). Produces linear RGBA owned by the caller;
 // scratch (N-buffers, mipmaps) lives in the MultiviewScratch the caller may keep between frames.
 //
 // Determinism: the image is split into tiles; each output pixel is computed by one task, its
@@ -54,8 +55,9 @@ enum class Traversal : uint8_t {
 // What happens to a lens ray whose path leaves the image (§4.3 "Handling Off-Screen Pixels").
 enum class OffscreenPolicy : uint8_t {
     Discard, // the paper: the ray is dropped and the remaining rays' weights renormalised
-    Clamp,   // the ray reads the nearest border texel instead; the default: closer to accum
-             // than Discard on every built-in scene, in PSNR and SSIM (docs/benchmarks.md)
+    Clamp,   // the ray reads the nearest border texel instead; the default: better than or equal
+             // to Discard against accum on every built-in scene, in PSNR and SSIM
+             // (docs/benchmarks.md)
 };
 
 // How a cone hit (§4.4) is shaded when hits are re-shaded per ray (§5). The paper mipmaps the
@@ -213,7 +215,8 @@ using LayersFn = std::function<raster::Status(const raster::View&, const raster:
                                               raster::LayeredTarget&)>;
 
 // The whole method: pinhole render (visible depth range, §4.1), layered render (§4.2), then
-// synthesizeMultiview. When nothing is visible the output is the pinhole frame. `rgba` as above.
+// synthesizeMultiview. When the lens cannot change the image (MultiviewStats::skipped) the output
+// is the pinhole frame. `rgba` as above.
 raster::Result<MultiviewStats>
 renderMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
                 const MultiviewSettings& settings, const ShadingInputs& shading,
