@@ -352,9 +352,8 @@ glm::vec3 envLookup(const EnvironmentMap& env, glm::vec3 dir) {
 // §5: shade the G-buffer sample of a hit from lens point `eye`: the rasterizer's Phong model
 // (raster::shadeSurface) plus, with an environment map, a Schlick-Fresnel mirror reflection
 // attenuated by roughness.
-glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::vec3 eye) {
-    const raster::LayeredTarget& lt = *tr.layers;
-    const raster::GSample& g = lt.gbuffer[lt.index(l, texel)];
+glm::vec3 shadeSample(const Tracer& tr, const raster::GSample& g, uint32_t texel, float t,
+                      glm::vec3 eye) {
     const raster::View& view = *tr.view;
     // World position of the texel centre at its stored depth (pinhole through the lens centre).
     const float d = distanceFromD(view, t);
@@ -376,6 +375,11 @@ glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::v
         c += fresnel * gloss * envLookup(*env, r);
     }
     return c;
+}
+
+glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::vec3 eye) {
+    const raster::LayeredTarget& lt = *tr.layers;
+    return shadeSample(tr, lt.gbuffer[lt.index(l, texel)], texel, t, eye);
 }
 
 // §4.4 + §5: the shaded colour of a cone of radius `radius` px around image position (px, py)
@@ -595,7 +599,16 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                             ? sampleCone(tr, tr.scratch->transparent_mips[l], cx + ct * w.x,
                                          cy + ct * w.y, tr.lambda * std::fabs(ct))
                             : lt.transparent_color.load(lt.index(l, ht.texel));
-                    color += transmit * glm::vec3(m);
+                    glm::vec3 rgb(m);
+                    const size_t ti = lt.index(l, ht.texel);
+                    if (shade && lt.transparent_panes[ti] == 1) {
+                        // §5 for a texel holding one pane: re-shade it from this ray's origin
+                        // (the cone's or texel's opacity, the hit texel's surface).
+                        const glm::vec3 from = s.view_dependent ? lens_point : view.eye;
+                        rgb =
+                            m.a * shadeSample(tr, lt.transparent_gbuffer[ti], ht.texel, ht.t, from);
+                    }
+                    color += transmit * rgb;
                     transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
                     t_end = ht.t;
                     if (rec)
@@ -768,8 +781,10 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     if (layers.layer_count == 0 || layers.layer_count > raster::kMaxLayers)
         return Status::error("multiview: the layered target has no layers");
     const bool shade = settings.view_dependent || settings.env_map;
-    if (shade &&
-        (layers.gbuffer.size() != layers.pixelCount() * layers.layer_count || !shading.scene))
+    const size_t layer_texels = layers.pixelCount() * layers.layer_count;
+    if (shade && (layers.gbuffer.size() != layer_texels || !shading.scene ||
+                  (layers.hasTransparency() && (layers.transparent_gbuffer.size() != layer_texels ||
+                                                layers.transparent_panes.size() != layer_texels))))
         return Status::error("--view-dependent needs layers rendered with a G-buffer");
 
     MultiviewStats stats;

@@ -223,6 +223,9 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
                                  glm::vec4(0.0f));
     out.transparent_depth.resize(desc.depth_format, transparency ? view.width : 0,
                                  transparency ? view.height * layers : 0);
+    const bool transparent_gbuffer = transparency && desc.gbuffer;
+    out.transparent_gbuffer.assign(transparent_gbuffer ? pixels * layers : 0, GSample{});
+    out.transparent_panes.assign(transparent_gbuffer ? pixels * layers : 0, 0);
     std::vector<LayerInterval> intervals(layers);
     for (uint32_t l = 0; l < layers; ++l)
         intervals[l] = overlappedInterval(desc, l);

@@ -65,13 +65,19 @@ struct LayeredTarget {
     // and the depth of the nearest of them. Each BLEND fragment is in exactly one plane.
     ColorBuffer transparent_color;
     DepthBuffer transparent_depth;
+    // With desc.gbuffer and a transparent plane: the G-buffer sample of each plane texel's first
+    // pane and how many panes the texel composites (saturating at 255), so that a texel holding
+    // one pane can be re-shaded per ray (Lee et al. §5); several panes keep their composite.
+    std::vector<GSample> transparent_gbuffer;
+    std::vector<uint8_t> transparent_panes;
 
     size_t pixelCount() const { return size_t(width) * height; }
     size_t index(uint32_t layer, size_t pixel) const { return layer * pixelCount() + pixel; }
     bool hasTransparency() const { return transparent_depth.bytes() > 0; }
     size_t bytes() const {
         return color.bytes() + depth.bytes() + gbuffer.size() * sizeof(GSample) +
-               transparent_color.bytes() + transparent_depth.bytes();
+               transparent_color.bytes() + transparent_depth.bytes() +
+               transparent_gbuffer.size() * sizeof(GSample) + transparent_panes.size();
     }
 };
 
