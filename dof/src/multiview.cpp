@@ -349,32 +349,39 @@ glm::vec3 envLookup(const EnvironmentMap& env, glm::vec3 dir) {
     return glm::vec3(p[0], p[1], p[2]) * env.intensity;
 }
 
-// §5: shade the G-buffer sample of a hit from lens point `eye`: the rasterizer's Phong model
-// (raster::shadeSurface) plus, with an environment map, a Schlick-Fresnel mirror reflection
-// attenuated by roughness.
-glm::vec3 shadeSample(const Tracer& tr, const raster::GSample& g, uint32_t texel, float t,
-                      glm::vec3 eye) {
+// World position of texel `texel` at stored depth t (pinhole through the lens centre).
+glm::vec3 texelWorld(const Tracer& tr, uint32_t texel, float t) {
     const raster::View& view = *tr.view;
-    // World position of the texel centre at its stored depth (pinhole through the lens centre).
     const float d = distanceFromD(view, t);
     const uint32_t ix = texel % tr.width, iy = texel / tr.width;
     const float f_px = tr.lens->focal_length_px;
     const float sx = (float(ix) + 0.5f - 0.5f * float(tr.width)) / f_px;
     const float sy = (float(iy) + 0.5f - 0.5f * float(tr.height)) / f_px;
-    const glm::vec3 world = view.eye + d * (view.forward + sx * view.right - sy * view.up);
-    glm::vec3 c = tr.shader->shade(g, world, eye);
+    return view.eye + d * (view.forward + sx * view.right - sy * view.up);
+}
+
+// With an environment map: a Schlick-Fresnel mirror reflection attenuated by roughness.
+glm::vec3 envReflection(const Tracer& tr, const raster::GSample& g, glm::vec3 world,
+                        glm::vec3 eye) {
     const EnvironmentMap* env = tr.settings->env_map;
-    if (env && g.unlit == 0.0f) {
-        const glm::vec3 vdir = glm::normalize(eye - world);
-        const float n_dot_v = std::max(glm::dot(g.normal, vdir), 0.0f);
-        const glm::vec3 r = glm::reflect(-vdir, g.normal);
-        const glm::vec3 f0 = glm::mix(glm::vec3(0.04f), g.base_color, g.metallic);
-        const float m = 1.0f - n_dot_v;
-        const glm::vec3 fresnel = f0 + (glm::vec3(1.0f) - f0) * (m * m * m * m * m);
-        const float gloss = (1.0f - g.roughness) * (1.0f - g.roughness);
-        c += fresnel * gloss * envLookup(*env, r);
-    }
-    return c;
+    if (!env || g.unlit != 0.0f)
+        return glm::vec3(0.0f);
+    const glm::vec3 vdir = glm::normalize(eye - world);
+    const float n_dot_v = std::max(glm::dot(g.normal, vdir), 0.0f);
+    const glm::vec3 r = glm::reflect(-vdir, g.normal);
+    const glm::vec3 f0 = glm::mix(glm::vec3(0.04f), g.base_color, g.metallic);
+    const float m = 1.0f - n_dot_v;
+    const glm::vec3 fresnel = f0 + (glm::vec3(1.0f) - f0) * (m * m * m * m * m);
+    const float gloss = (1.0f - g.roughness) * (1.0f - g.roughness);
+    return fresnel * gloss * envLookup(*env, r);
+}
+
+// §5: shade the G-buffer sample of texel `texel` at stored depth t from lens point `eye`: the
+// rasterizer's Phong model (raster::SurfaceShader) plus the environment reflection.
+glm::vec3 shadeSample(const Tracer& tr, const raster::GSample& g, uint32_t texel, float t,
+                      glm::vec3 eye) {
+    const glm::vec3 world = texelWorld(tr, texel, t);
+    return tr.shader->shade(g, world, eye) + envReflection(tr, g, world, eye);
 }
 
 glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::vec3 eye) {
@@ -601,12 +608,20 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                             : lt.transparent_color.load(lt.index(l, ht.texel));
                     glm::vec3 rgb(m);
                     const size_t ti = lt.index(l, ht.texel);
-                    if (shade && lt.transparent_panes[ti] == 1) {
-                        // §5 for a texel holding one pane: re-shade it from this ray's origin
-                        // (the cone's or texel's opacity, the hit texel's surface).
+                    if (shade && lt.transparent_top_alpha[ti] > 0.0f) {
+                        // §5 for the plane: the composite is linear in its top pane's colour,
+                        // which the rasterizer shaded from the lens centre; swap in the top
+                        // pane shaded from this ray's origin (scaled by the cone's share of the
+                        // texel's opacity).
+                        const raster::GSample& g = lt.transparent_gbuffer[ti];
+                        const glm::vec3 world = texelWorld(tr, ht.texel, ht.t);
                         const glm::vec3 from = s.view_dependent ? lens_point : view.eye;
-                        rgb =
-                            m.a * shadeSample(tr, lt.transparent_gbuffer[ti], ht.texel, ht.t, from);
+                        const glm::vec3 centre = tr.shader->shade(g, world, view.eye);
+                        const glm::vec3 ray =
+                            tr.shader->shade(g, world, from) + envReflection(tr, g, world, from);
+                        const float texel_a = lt.transparent_color.load(ti).a;
+                        const float share = texel_a > 0.0f ? std::min(m.a / texel_a, 1.0f) : 0.0f;
+                        rgb += share * lt.transparent_top_alpha[ti] * (ray - centre);
                     }
                     color += transmit * rgb;
                     transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
@@ -782,9 +797,10 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         return Status::error("multiview: the layered target has no layers");
     const bool shade = settings.view_dependent || settings.env_map;
     const size_t layer_texels = layers.pixelCount() * layers.layer_count;
-    if (shade && (layers.gbuffer.size() != layer_texels || !shading.scene ||
-                  (layers.hasTransparency() && (layers.transparent_gbuffer.size() != layer_texels ||
-                                                layers.transparent_panes.size() != layer_texels))))
+    if (shade &&
+        (layers.gbuffer.size() != layer_texels || !shading.scene ||
+         (layers.hasTransparency() && (layers.transparent_gbuffer.size() != layer_texels ||
+                                       layers.transparent_top_alpha.size() != layer_texels))))
         return Status::error("--view-dependent needs layers rendered with a G-buffer");
 
     MultiviewStats stats;

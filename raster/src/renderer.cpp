@@ -225,7 +225,7 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
                                  transparency ? view.height * layers : 0);
     const bool transparent_gbuffer = transparency && desc.gbuffer;
     out.transparent_gbuffer.assign(transparent_gbuffer ? pixels * layers : 0, GSample{});
-    out.transparent_panes.assign(transparent_gbuffer ? pixels * layers : 0, 0);
+    out.transparent_top_alpha.assign(transparent_gbuffer ? pixels * layers : 0, 0.0f);
     std::vector<LayerInterval> intervals(layers);
     for (uint32_t l = 0; l < layers; ++l)
         intervals[l] = overlappedInterval(desc, l);

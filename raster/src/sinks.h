@@ -84,11 +84,9 @@ struct LayerSink {
             target.transparent_color.store(i, blendOver(f.color, target.transparent_color.load(i)));
             if (target.transparent_depth.quantize(f.z) < target.transparent_depth.load(i))
                 target.transparent_depth.store(i, f.z);
-            if (wants_gbuffer) {
-                uint8_t& panes = target.transparent_panes[i];
-                if (panes == 0)
-                    target.transparent_gbuffer[i] = f.g;
-                panes = uint8_t(std::min(panes + 1, 255));
+            if (wants_gbuffer) { // the new top pane
+                target.transparent_gbuffer[i] = f.g;
+                target.transparent_top_alpha[i] = f.color.a;
             }
             return;
         }

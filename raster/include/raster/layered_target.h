@@ -65,11 +65,12 @@ struct LayeredTarget {
     // and the depth of the nearest of them. Each BLEND fragment is in exactly one plane.
     ColorBuffer transparent_color;
     DepthBuffer transparent_depth;
-    // With desc.gbuffer and a transparent plane: the G-buffer sample of each plane texel's first
-    // pane and how many panes the texel composites (saturating at 255), so that a texel holding
-    // one pane can be re-shaded per ray (Lee et al. §5); several panes keep their composite.
+    // With desc.gbuffer and a transparent plane: the G-buffer sample of each plane texel's top
+    // pane (the last one composited) and its opacity (0: no pane). The composite is linear in
+    // the top pane's colour, so the pane can be re-shaded from another eye exactly
+    // (Lee et al. §5). 52 bytes per texel and layer.
     std::vector<GSample> transparent_gbuffer;
-    std::vector<uint8_t> transparent_panes;
+    std::vector<float> transparent_top_alpha;
 
     size_t pixelCount() const { return size_t(width) * height; }
     size_t index(uint32_t layer, size_t pixel) const { return layer * pixelCount() + pixel; }
@@ -77,7 +78,8 @@ struct LayeredTarget {
     size_t bytes() const {
         return color.bytes() + depth.bytes() + gbuffer.size() * sizeof(GSample) +
                transparent_color.bytes() + transparent_depth.bytes() +
-               transparent_gbuffer.size() * sizeof(GSample) + transparent_panes.size();
+               transparent_gbuffer.size() * sizeof(GSample) +
+               transparent_top_alpha.size() * sizeof(float);
     }
 };
 

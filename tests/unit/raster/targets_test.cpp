@@ -182,16 +182,17 @@ TEST(LayeredTarget, BlendSurfacesGoToTheTransparentPlane) {
         EXPECT_NEAR(tc.b, 0.3f, 1e-6f);
         EXPECT_NEAR(tc.a, 0.7f, 1e-6f);
         EXPECT_NEAR(raster::distanceFromDepth(v, t.transparent_depth.load(p)), 4.0f, 1e-3f);
-        EXPECT_TRUE(t.transparent_panes.empty()); // no G-buffer asked for
+        EXPECT_TRUE(t.transparent_top_alpha.empty()); // no G-buffer asked for
     }
-    // With a G-buffer the plane counts its panes and keeps the first pane's surface (drawn in
-    // primitive order: the blue one) for re-shading.
+    // With a G-buffer the plane keeps its top pane's surface and opacity (the last composited
+    // in primitive order: the red one) for re-shading.
     desc.gbuffer = true;
     const raster::LayeredTarget g = layers(s, v, desc);
     const size_t p = g.index(0, size_t(36) * 96 + 48);
-    ASSERT_EQ(g.transparent_panes.size(), g.pixelCount());
-    EXPECT_EQ(g.transparent_panes[p], 2u);
-    EXPECT_EQ(g.transparent_gbuffer[p].base_color, glm::vec3(0.0f, 0.0f, 1.0f));
+    ASSERT_EQ(g.transparent_top_alpha.size(), g.pixelCount());
+    EXPECT_EQ(g.transparent_top_alpha[p], 0.4f);
+    EXPECT_EQ(g.transparent_gbuffer[p].base_color, glm::vec3(1.0f, 0.0f, 0.0f));
+    EXPECT_EQ(g.transparent_top_alpha[g.index(0, 0)], 0.4f); // the panes cover the image
     // Scenes without BLEND materials get no transparent planes (no memory).
     EXPECT_FALSE(
         layers(stackScene(false), v, stackDesc(LayerRouting::PerFragment, 0.1f)).hasTransparency());
