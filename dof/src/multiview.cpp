@@ -1132,10 +1132,14 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     }
     if (!skip_reason.empty()) {
         rgba = pinhole.color;
+        if (layers_out)
+            *layers_out = raster::LayeredTarget{}; // no decomposition was made
         MultiviewStats stats;
         stats.skipped = true;
         stats.skip_reason = std::move(skip_reason);
         stats.ms_pinhole = ms_pinhole;
+        if (range.covered)
+            stats.d_near = range.near_d, stats.d_far = range.far_d;
         return stats;
     }
     LayerSpacing spacing;

@@ -135,9 +135,10 @@ struct MultiviewSettings {
 };
 
 struct MultiviewStats {
-    // The lens cannot change the image (as accum decides it: aperture 0, or every visible depth
-    // has |C(d)| < 0.5 px; or nothing is visible), so the pinhole render is the result. Not with
-    // an environment map (its reflections need the synthesis) or skip_unblurred off.
+    // The pinhole render is the result: nothing is visible, or the lens cannot change the image
+    // (as accum decides it: aperture 0, or every visible depth has |C(d)| < 0.5 px; this test is
+    // not made with an environment map, whose reflections need the synthesis, or with
+    // skip_unblurred off).
     bool skipped = false;
     std::string skip_reason;
     // Counts (deterministic).

@@ -418,6 +418,10 @@ TEST(Multiview, SameBytesForEveryThreadCount) {
     lit.unlit = false;
     lit.roughness_factor = 0.2f;
     addQuad(scene, -20.0f, -5.0f, 8.0f, 15.0f, 60.0f, addMaterial(scene, lit));
+    raster::Material glass = flatMaterial({0.2f, 0.4f, 0.9f, 0.4f}, raster::AlphaMode::Blend);
+    glass.unlit = false;
+    glass.roughness_factor = 0.2f;
+    addQuad(scene, 0.0f, -20.0f, 20.0f, 0.0f, 70.0f, addMaterial(scene, glass)); // re-shaded (§5)
     const dof::ThinLens lens = dof::makeThinLens(view, 10.0f, 100.0f);
     dof::ApertureShape hex;
     hex.kind = dof::ApertureKind::Polygon;
