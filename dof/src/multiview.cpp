@@ -376,17 +376,15 @@ glm::vec3 envReflection(const Tracer& tr, const raster::GSample& g, glm::vec3 wo
     return fresnel * gloss * envLookup(*env, r);
 }
 
-// §5: shade the G-buffer sample of texel `texel` at stored depth t from lens point `eye`: the
-// rasterizer's Phong model (raster::SurfaceShader) plus the environment reflection.
-glm::vec3 shadeSample(const Tracer& tr, const raster::GSample& g, uint32_t texel, float t,
-                      glm::vec3 eye) {
-    const glm::vec3 world = texelWorld(tr, texel, t);
+// §5: shade G-buffer sample g at `world` from lens point `eye`: the rasterizer's Phong model
+// (raster::SurfaceShader) plus the environment reflection.
+glm::vec3 shadeSample(const Tracer& tr, const raster::GSample& g, glm::vec3 world, glm::vec3 eye) {
     return tr.shader->shade(g, world, eye) + envReflection(tr, g, world, eye);
 }
 
 glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::vec3 eye) {
     const raster::LayeredTarget& lt = *tr.layers;
-    return shadeSample(tr, lt.gbuffer[lt.index(l, texel)], texel, t, eye);
+    return shadeSample(tr, lt.gbuffer[lt.index(l, texel)], texelWorld(tr, texel, t), eye);
 }
 
 // §4.4 + §5: the shaded colour of a cone of radius `radius` px around image position (px, py)
@@ -550,9 +548,11 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 rec->discarded = true, rec->t_end = t_first, rec->end_px = rec->start_px;
             continue;
         }
-        const glm::vec3 lens_point =
-            view.eye +
-            tr.lens->aperture_radius * (ls.position.x * view.right + ls.position.y * view.up);
+        // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
+        const glm::vec3 shade_from =
+            s.view_dependent ? view.eye + tr.lens->aperture_radius *
+                                              (ls.position.x * view.right + ls.position.y * view.up)
+                             : view.eye;
         glm::vec3 color(0.0f);
         float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4)
         float t_resume = -1.0f;
@@ -615,10 +615,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                         // texel's opacity).
                         const raster::GSample& g = lt.transparent_gbuffer[ti];
                         const glm::vec3 world = texelWorld(tr, ht.texel, ht.t);
-                        const glm::vec3 from = s.view_dependent ? lens_point : view.eye;
                         const glm::vec3 centre = tr.shader->shade(g, world, view.eye);
-                        const glm::vec3 ray =
-                            tr.shader->shade(g, world, from) + envReflection(tr, g, world, from);
+                        const glm::vec3 ray = shadeSample(tr, g, world, shade_from);
                         const float texel_a = lt.transparent_color.load(ti).a;
                         const float share = texel_a > 0.0f ? std::min(m.a / texel_a, 1.0f) : 0.0f;
                         rgb += share * lt.transparent_top_alpha[ti] * (ray - centre);
@@ -646,13 +644,11 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             } else {
                 c1 = glm::vec3(lt.color.load(lt.index(l, h.texel)));
             }
-            if (shade) {
-                const glm::vec3 from = s.view_dependent ? lens_point : view.eye;
+            if (shade)
                 c1 = cone_hit
                          ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * w.x, cy + c_hit * w.y,
-                                          0.5f * tr.lambda * std::fabs(c_hit), from)
-                         : shadeHit(tr, l, h.texel, h.t, from);
-            }
+                                          0.5f * tr.lambda * std::fabs(c_hit), shade_from)
+                         : shadeHit(tr, l, h.texel, h.t, shade_from);
             if (rec)
                 rec->layer = int32_t(l);
             if (v1 >= kFullCoverage) {
