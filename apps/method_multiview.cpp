@@ -32,6 +32,7 @@ struct MultiviewArgs {
     std::string bound_init = "off";
     std::string thickness = "2";
     std::string cone = "on";
+    std::string cone_misses = "on";
     std::string culling = "on";
     std::string precompute_paths = "on";
     std::string jitter = "none";
@@ -278,6 +279,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     s.bound_init = a.bound_init == "on";
     s.thickness_px = parseThickness(a.thickness).value_or(INFINITY); // checked when parsed
     s.cone = a.cone == "on";
+    s.cone_misses = a.cone_misses == "on";
     s.culling = a.culling == "on";
     s.precompute_paths = a.precompute_paths == "on";
     s.jitter = a.jitter == "none"     ? dof::JitterMode::None
@@ -383,6 +385,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"bound_init", s.bound_init},
         {"thickness_px", a.thickness},
         {"cone", s.cone},
+        {"cone_misses", s.cone_misses},
         {"culling", s.culling},
         {"precompute_paths", s.precompute_paths},
         {"skip_unblurred", s.skip_unblurred},
@@ -416,6 +419,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                   {"layers_culled_tile", st.layer_culled_tile},
                   {"layers_culled_ray", st.layer_culled_ray},
                   {"cone_partial", st.cone_partial},
+                  {"cone_missed", st.cone_missed},
                   {"texel_fetches", st.texel_fetches},
                   {"transparent_hits", st.transparent_hits},
                   {"path_cells", st.path_cells},
@@ -477,6 +481,11 @@ MethodEntry makeMultiviewMethod() {
                 },
                 "PX|inf"));
         cmd.add_option("--cone", args->cone, "multiview: approximate cone tracing (Sec. 4.4)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"on", "off"}));
+        cmd.add_option("--cone-misses", args->cone_misses,
+                       "multiview: with --cone on, a ray crossing a layer without a hit also looks "
+                       "its cone up there (off: the paper's rule, cones only at hits)")
             ->capture_default_str()
             ->check(CLI::IsMember({"on", "off"}));
         cmd.add_option("--culling", args->culling,

@@ -45,6 +45,10 @@ struct LayerSeg {
     float t0 = 0.0f, t1 = 0.0f;     // segment bounds in D (overlapped interval, §4.2)
     float own0 = 0.0f, own1 = 0.0f; // the layer's own (not overlapped) interval in D
     float reach_px = 0.0f;          // farthest image offset of any ray in the segment
+    // A ray missing the layer looks its cone up at stored depth t_cone
+    // (MultiviewSettings::cone_misses); the lookup reads texels within cone_px of the ray's
+    // position there (0: misses are not coned).
+    float t_cone = 0.0f, cone_px = 0.0f;
     bool empty = true;
     bool transparent = false; // the transparent plane has content
 };
@@ -74,7 +78,8 @@ struct RayPath {
 
 struct TileCounters {
     uint64_t rays = 0, discarded = 0, background = 0, layer_tests = 0, culled_pixel = 0,
-             culled_tile = 0, culled_ray = 0, cone_partial = 0, fetches = 0, transparent_hits = 0;
+             culled_tile = 0, culled_ray = 0, cone_partial = 0, cone_missed = 0, fetches = 0,
+             transparent_hits = 0;
 };
 
 // Everything the per-pixel loop reads; built once per frame.
@@ -301,10 +306,12 @@ Hit scanPath(const Tracer& tr, const float* depth, float seg_near, float s1, uin
     return hit;
 }
 
-// Trilinear lookup of a layer's premultiplied coverage mipmap `mip` (§4.4) at image position
+// Trilinear lookup of a layer mipmap `mip` with C channels per texel (§4.4) at image position
 // (px, py) for a window of `diameter` pixels.
-glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mip, float px,
-                     float py, float diameter) {
+template <int C>
+glm::vec<C, float> sampleMip(const Tracer& tr, const std::vector<std::vector<float>>& mip, float px,
+                             float py, float diameter) {
+    using Vec = glm::vec<C, float>;
     const MultiviewScratch& sc = *tr.scratch;
     const uint32_t top = uint32_t(sc.mip_width.size()) - 1;
     const float level = std::clamp(std::log2(std::max(diameter, 1.0f)), 0.0f, float(top));
@@ -324,20 +331,28 @@ glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mi
         const int64_t iv = int64_t(std::clamp(fv, -1.0f, float(h)));
         const int64_t x0 = std::clamp<int64_t>(iu, 0, w - 1);
         const int64_t x1 = std::clamp<int64_t>(iu + 1, 0, w - 1);
-        const float* r0 = img.data() + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * 4;
-        const float* r1 = img.data() + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * 4;
+        const float* r0 = img.data() + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * C;
+        const float* r1 = img.data() + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * C;
         auto at = [](const float* row, int64_t x) {
-            const float* p = row + x * 4;
-            return glm::vec4(p[0], p[1], p[2], p[3]);
+            Vec t;
+            for (int c = 0; c < C; ++c)
+                t[c] = row[x * C + c];
+            return t;
         };
-        const glm::vec4 top_row = at(r0, x0) * (1.0f - au) + at(r0, x1) * au;
-        const glm::vec4 bottom = at(r1, x0) * (1.0f - au) + at(r1, x1) * au;
+        const Vec top_row = at(r0, x0) * (1.0f - au) + at(r0, x1) * au;
+        const Vec bottom = at(r1, x0) * (1.0f - au) + at(r1, x1) * au;
         return top_row * (1.0f - av) + bottom * av;
     };
-    const glm::vec4 c0 = bilinear(l0);
+    const Vec c0 = bilinear(l0);
     if (l1 == l0 || f == 0.0f)
         return c0;
     return c0 * (1.0f - f) + bilinear(l1) * f;
+}
+
+// A layer's premultiplied coverage mipmap (RGBA, alpha = coverage) at a cone (§4.4).
+glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mip, float px,
+                     float py, float diameter) {
+    return sampleMip<4>(tr, mip, px, py, diameter);
 }
 
 glm::vec3 envLookup(const EnvironmentMap& env, glm::vec3 dir) {
@@ -387,13 +402,11 @@ glm::vec3 shadeHit(const Tracer& tr, uint32_t l, uint32_t texel, float t, glm::v
     return shadeSample(tr, lt.gbuffer[lt.index(l, texel)], texelWorld(tr, texel, t), eye);
 }
 
-// §4.4 + §5: the shaded colour of a cone of radius `radius` px around image position (px, py)
-// in layer l. ConeShading::Footprint averages the covered texels among five taps (the centre and
-// +-radius/2 along x and y), each shaded at its own stored depth; Centre shades the hit texel.
-glm::vec3 shadeFootprint(const Tracer& tr, uint32_t l, uint32_t texel, float t, float px, float py,
-                         float radius, glm::vec3 eye) {
-    if (tr.settings->cone_shading == ConeShading::Centre || radius <= 0.5f)
-        return shadeHit(tr, l, texel, t, eye);
+// §4.4 + §5: the mean shaded colour of the covered texels among five taps of a cone of radius
+// `radius` px around image position (px, py) in layer l (the centre and +-radius/2 along x and
+// y), each shaded at its own stored depth; none when no tap is covered.
+std::optional<glm::vec3> shadeTaps(const Tracer& tr, uint32_t l, float px, float py, float radius,
+                                   glm::vec3 eye) {
     const raster::LayeredTarget& lt = *tr.layers;
     const std::vector<float>& depth = tr.scratch->depth[l];
     const float hr = 0.5f * radius;
@@ -411,7 +424,19 @@ glm::vec3 shadeFootprint(const Tracer& tr, uint32_t l, uint32_t texel, float t, 
         sum += shadeHit(tr, l, ti, depth[ti], eye);
         ++count;
     }
-    return count > 0 ? sum / float(count) : shadeHit(tr, l, texel, t, eye);
+    if (count == 0)
+        return std::nullopt;
+    return sum / float(count);
+}
+
+// The shaded colour of a cone hit on texel `texel` at depth t: ConeShading::Footprint uses the
+// taps (the hit texel when none is covered), Centre shades the hit texel.
+glm::vec3 shadeFootprint(const Tracer& tr, uint32_t l, uint32_t texel, float t, float px, float py,
+                         float radius, glm::vec3 eye) {
+    if (tr.settings->cone_shading == ConeShading::Footprint && radius > 0.5f)
+        if (const std::optional<glm::vec3> c = shadeTaps(tr, l, px, py, radius, eye))
+            return *c;
+    return shadeHit(tr, l, texel, t, eye);
 }
 
 // The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
@@ -455,13 +480,60 @@ bool boxCulled(const Tracer& tr, uint32_t l, int64_t x0, int64_t x1, int64_t y0,
     return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > tr.segs[l].t1;
 }
 
-// Whether layer l can be skipped for every ray of the pixels [x0, x1] x [y0, y1]: a ray stays
+// Whether no ray of the pixels [x0, x1] x [y0, y1] can meet a texel of layer l: a ray stays
 // within reach_px of its pixel centre in the layer, so it reads texel offsets within
-// [floor(0.5 - reach), floor(0.5 + reach)] of its pixel (PathCell).
-bool culled(const Tracer& tr, uint32_t l, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1) {
-    const float r = tr.segs[l].reach_px;
+// [floor(0.5 - reach), floor(0.5 + reach)] of its pixel (PathCell). With `cones`, whether their
+// missed cones see none either (they read cone_px further): the layer can then be skipped.
+bool culled(const Tracer& tr, uint32_t l, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+            bool cones) {
+    const float r = tr.segs[l].reach_px + (cones ? tr.segs[l].cone_px : 0.0f);
     const int64_t lo = int64_t(std::floor(0.5f - r)), hi = int64_t(std::floor(0.5f + r));
     return boxCulled(tr, l, int64_t(x0) + lo, int64_t(x1) + hi, int64_t(y0) + lo, int64_t(y1) + hi);
+}
+
+// A lens ray that crossed layer l's segment without a hit still has a cone around it (§4.4
+// thickens every ray, so the gaps between lens samples are covered whether or not the centre
+// ray hits). The cone is placed where the ray passes the layer's content: first at the middle
+// of the layer (t_cone), then at the mean depth of the covered texels found there (a small
+// object's image offset C, and so where the ray passes it, depends on its depth). Its coverage
+// v1 and colour c1 enter the continuation v1 c1 + (1 - v1) c2 like a partial hit. Only inside
+// the image (the culling margin cone_px relies on it). Returns whether the cone blocked the ray.
+bool coneMiss(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w, bool shade,
+              glm::vec3 eye, glm::vec3& color, float& transmit, TileCounters& cnt) {
+    const LayerSeg& seg = tr.segs[l];
+    auto inside = [&](float px, float py) {
+        return px >= 0.0f && py >= 0.0f && px < float(tr.width) && py < float(tr.height);
+    };
+    float c = tr.cocOf(seg.t_cone);
+    float px = cx + c * w.x, py = cy + c * w.y;
+    if (!inside(px, py))
+        return false;
+    // Nothing of the layer within the first lookup's reach (one N-buffer query, lossless).
+    if (tr.settings->culling &&
+        boxCulled(tr, l, int64_t(std::floor(px - seg.cone_px)),
+                  int64_t(std::floor(px + seg.cone_px)), int64_t(std::floor(py - seg.cone_px)),
+                  int64_t(std::floor(py + seg.cone_px))))
+        return false;
+    const glm::vec2 d =
+        sampleMip<2>(tr, tr.scratch->depth_mips[l], px, py, tr.lambda * std::fabs(c));
+    if (!(d.y > 0.0f))
+        return false;
+    c = tr.cocOf(std::clamp(d.x / d.y, seg.t0, seg.t1));
+    px = cx + c * w.x, py = cy + c * w.y;
+    const float diameter = tr.lambda * std::fabs(c);
+    if (!inside(px, py) || !(diameter > 1.0f))
+        return false;
+    const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], px, py, diameter);
+    const float v1 = std::clamp(m.a, 0.0f, 1.0f);
+    if (!(v1 > 0.0f))
+        return false;
+    ++cnt.cone_missed;
+    glm::vec3 c1 = glm::vec3(m) / m.a;
+    if (shade && tr.settings->cone_shading == ConeShading::Footprint)
+        c1 = shadeTaps(tr, l, px, py, 0.5f * diameter, eye).value_or(c1);
+    color += transmit * v1 * c1;
+    transmit = v1 >= kFullCoverage ? 0.0f : transmit * (1.0f - v1);
+    return transmit == 0.0f;
 }
 
 // The cells a path from offset o0 to o1 can cross lie in the box of its end cells.
@@ -493,15 +565,19 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 uint32_t tile_layer_count, float* out, TileCounters& cnt) {
     const MultiviewSettings& s = *tr.settings;
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
-    // Layers this pixel's rays can hit (early culling per pixel, §4.3).
+    // Layers this pixel's rays or their missed cones can meet (early culling per pixel, §4.3);
+    // bit i of `reach` is set when active[i] can be hit at all (else only its cones matter).
     std::array<uint32_t, raster::kMaxLayers> active{};
+    uint64_t reach = 0;
     uint32_t active_count = 0;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
         const uint32_t l = tile_layers[i];
-        if (s.culling && culled(tr, l, x, x, y, y)) {
+        if (s.culling && culled(tr, l, x, x, y, y, true)) {
             ++cnt.culled_pixel;
             continue;
         }
+        if (!s.culling || tr.segs[l].cone_px == 0.0f || !culled(tr, l, x, x, y, y, false))
+            reach |= uint64_t(1) << active_count;
         active[active_count++] = l;
     }
     // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
@@ -565,7 +641,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 continue;
             // The whole segment's path walked in advance, unless the ray resumes inside it.
             const RayPath* path = paths && s0 == seg.t0 ? &paths[l] : nullptr;
-            if (s.culling && (!path || path->count > kRayCullMinCells)) {
+            bool can_hit = (reach >> i) & 1;
+            if (can_hit && s.culling && (!path || path->count > kRayCullMinCells)) {
                 // Per-ray culling: the texels this ray's segment can read lie in the box of its
                 // end points; one N-buffer query skips the height-field test when none of them
                 // is within the layer (the same test as §4.3's per-pixel culling, on a smaller
@@ -577,18 +654,21 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 if (boxCulled(tr, l, int64_t(x) + box.x0, int64_t(x) + box.x1, int64_t(y) + box.y0,
                               int64_t(y) + box.y1)) {
                     ++cnt.culled_ray;
-                    continue;
+                    can_hit = false;
                 }
             }
-            ++cnt.layer_tests;
             auto trace = [&](const std::vector<float>& depth, float near, float t_a, float t_b) {
                 return s.traversal == Traversal::Scan
                            ? scanHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt)
                            : traceHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt);
             };
-            const Hit h =
-                path ? scanPath(tr, tr.scratch->depth[l].data(), seg.t0, seg.t1, x, y, *path, cnt)
-                     : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
+            Hit h;
+            if (can_hit) {
+                ++cnt.layer_tests;
+                h = path ? scanPath(tr, tr.scratch->depth[l].data(), seg.t0, seg.t1, x, y, *path,
+                                    cnt)
+                         : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
+            }
             // The layer's transparent plane in front of its opaque hit. The plane holds only
             // depths of the layer's own interval (LayerSink routes each BLEND fragment to the
             // one layer owning its depth), so only that part of the segment is searched. Its
@@ -596,7 +676,7 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             // (1 - opacity); with cone tracing both come from its mipmap (§4.4).
             const float ta = std::max(s0, seg.own0);
             const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
-            if (seg.transparent && ta < tb) {
+            if (can_hit && seg.transparent && ta < tb) {
                 const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
                 if (ht.hit) {
                     ++cnt.transparent_hits;
@@ -628,8 +708,17 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                         rec->layer = int32_t(l);
                 }
             }
-            if (!h.hit)
+            if (!h.hit) {
+                // The cone around a ray that crossed the whole segment without a hit.
+                if (seg.cone_px > 0.0f && s0 == seg.t0 &&
+                    coneMiss(tr, l, cx, cy, w, shade, shade_from, color, transmit, cnt)) {
+                    t_end = seg.t_cone;
+                    if (rec)
+                        rec->layer = int32_t(l);
+                    break;
+                }
                 continue;
+            }
             const float c_hit = tr.cocOf(h.t);
             glm::vec3 c1;
             float v1 = 1.0f;
@@ -663,7 +752,12 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 ++rec->partial_hits;
             color += transmit * v1 * c1;
             transmit *= 1.0f - v1;
-            t_resume = h.t + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
+            // Continue behind the solid part of the texel whose coverage was just counted (its
+            // stored depth plus the thickness; the paper's height field is solid to the
+            // layer's end), or the centre ray would hit that texel again.
+            const float solid_end =
+                std::min(tr.scratch->depth[l][h.texel] + tr.thickness_d, seg.t1);
+            t_resume = std::max(h.t, solid_end) + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
             t_end = h.t;
         }
         if (transmit > 0.0f) {
@@ -910,6 +1004,16 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         // monotonic in D, so the extreme is at an end).
         seg.reach_px =
             tr.r_max * std::max(std::fabs(tr.cocOf(seg.t0)), std::fabs(tr.cocOf(seg.t1)));
+        if (settings.cone && settings.cone_misses) {
+            // A missed cone is first looked up in the middle of the layer's own interval,
+            // then somewhere in the segment (coneMiss). A trilinear lookup at diameter Dc reads
+            // level floor(log2 Dc) + 1 at most, 1.5 of its texels either side.
+            seg.t_cone = 0.5f * (seg.own0 + seg.own1);
+            const float widest =
+                tr.lambda * std::max(std::fabs(tr.cocOf(seg.t0)), std::fabs(tr.cocOf(seg.t1)));
+            if (widest > 1.0f)
+                seg.cone_px = 1.5f * std::ldexp(1.0f, std::ilogb(widest) + 1) + 1.0f;
+        }
         if (!(seg.reach_px < kMaxReachPx))
             return Status::error("multiview: the lens blurs by more than 2^24 pixels over the "
                                  "visible depths (aperture radius " +
@@ -928,7 +1032,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                 return;
             // Window side 2 * reach + 2 texels for a pixel; the tile query uses more (it falls
             // back to a conservative tiling when the levels run out).
-            const float side = 2.0f * tr.segs[l].reach_px + 2.0f + float(settings.tile_size);
+            const float side = 2.0f * (tr.segs[l].reach_px + tr.segs[l].cone_px) + 2.0f +
+                               float(settings.tile_size);
             uint32_t level = 0;
             while (level < 16 && float(2u << level) <= side)
                 ++level;
@@ -951,6 +1056,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     t0 = Clock::now();
     scratch.mips.assign(m, {});
     scratch.transparent_mips.assign(transparency ? m : 0, {});
+    scratch.depth_mips.assign(settings.cone && settings.cone_misses ? m : 0, {});
     scratch.mip_width.clear();
     scratch.mip_height.clear();
     if (settings.cone) {
@@ -968,47 +1074,54 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             scratch.mip_height.push_back(std::max(1u, (scratch.mip_height.back() + 1) / 2));
         }
         stats.mip_levels = levels;
-        // Level 0 from `level0` (premultiplied RGBA per texel), then 2x2 box reductions.
-        auto build = [&](std::vector<std::vector<float>>& mip, auto&& level0) {
+        // Level 0 from `level0` (C channels per texel), then 2x2 box reductions.
+        auto build = [&]<uint32_t C>(std::vector<std::vector<float>>& mip, auto&& level0) {
             mip.resize(levels);
-            mip[0].resize(pixels * 4);
+            mip[0].resize(pixels * C);
             for (size_t i = 0; i < pixels; ++i) {
-                const glm::vec4 c = level0(i);
-                mip[0][i * 4] = c.r, mip[0][i * 4 + 1] = c.g, mip[0][i * 4 + 2] = c.b;
-                mip[0][i * 4 + 3] = c.a;
+                const glm::vec<C, float> c = level0(i);
+                for (uint32_t k = 0; k < C; ++k)
+                    mip[0][i * C + k] = c[k];
             }
             for (uint32_t lv = 1; lv < levels; ++lv) {
                 const uint32_t pw = scratch.mip_width[lv - 1], ph = scratch.mip_height[lv - 1];
                 const uint32_t cw = scratch.mip_width[lv], ch = scratch.mip_height[lv];
                 const std::vector<float>& src = mip[lv - 1];
                 std::vector<float>& dst = mip[lv];
-                dst.resize(size_t(cw) * ch * 4);
+                dst.resize(size_t(cw) * ch * C);
                 for (uint32_t y = 0; y < ch; ++y)
                     for (uint32_t x = 0; x < cw; ++x) {
                         const uint32_t x0 = std::min(2 * x, pw - 1),
                                        x1 = std::min(2 * x + 1, pw - 1);
                         const uint32_t y0 = std::min(2 * y, ph - 1),
                                        y1 = std::min(2 * y + 1, ph - 1);
-                        for (uint32_t c = 0; c < 4; ++c)
-                            dst[(size_t(y) * cw + x) * 4 + c] =
-                                0.25f * (src[(size_t(y0) * pw + x0) * 4 + c] +
-                                         src[(size_t(y0) * pw + x1) * 4 + c] +
-                                         src[(size_t(y1) * pw + x0) * 4 + c] +
-                                         src[(size_t(y1) * pw + x1) * 4 + c]);
+                        for (uint32_t c = 0; c < C; ++c)
+                            dst[(size_t(y) * cw + x) * C + c] =
+                                0.25f * (src[(size_t(y0) * pw + x0) * C + c] +
+                                         src[(size_t(y0) * pw + x1) * C + c] +
+                                         src[(size_t(y1) * pw + x0) * C + c] +
+                                         src[(size_t(y1) * pw + x1) * C + c]);
                     }
             }
         };
         pool.parallelFor(m, [&](uint32_t l, uint32_t) {
             if (tr.segs[l].empty)
                 return;
-            build(scratch.mips[l], [&](size_t i) { // coverage alpha: 1 where covered
+            build.template operator()<4>(scratch.mips[l], [&](size_t i) {
+                // coverage alpha: 1 where covered
                 const glm::vec4 c = layers.color.load(layers.index(l, i));
                 const float a = c.a > 0.0f ? 1.0f : 0.0f;
                 return glm::vec4(glm::vec3(c) * a, a);
             });
+            if (settings.cone_misses) // (D a, a): the covered texels' mean depth
+                build.template operator()<2>(scratch.depth_mips[l], [&](size_t i) {
+                    const float d = scratch.depth[l][i];
+                    return d == kEmptyDepth ? glm::vec2(0.0f) : glm::vec2(d, 1.0f);
+                });
             if (transparency) // already premultiplied, alpha = opacity
-                build(scratch.transparent_mips[l],
-                      [&](size_t i) { return layers.transparent_color.load(layers.index(l, i)); });
+                build.template operator()<4>(scratch.transparent_mips[l], [&](size_t i) {
+                    return layers.transparent_color.load(layers.index(l, i));
+                });
         });
     }
     stats.ms_mipmaps = msSince(t0);
@@ -1017,6 +1130,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             stats.scratch_bytes += lv.size() * sizeof(float);
         for (const std::vector<float>& lv : scratch.mips[l])
             stats.scratch_bytes += lv.size() * sizeof(float);
+        if (!scratch.depth_mips.empty())
+            for (const std::vector<float>& lv : scratch.depth_mips[l])
+                stats.scratch_bytes += lv.size() * sizeof(float);
         stats.scratch_bytes += scratch.depth[l].size() * sizeof(float);
         if (transparency) {
             for (const std::vector<float>& lv : scratch.transparent_mips[l])
@@ -1064,7 +1180,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         for (uint32_t l = 0; l < m; ++l) {
             if (tr.segs[l].empty)
                 continue;
-            if (settings.culling && culled(tr, l, x0, x1 - 1, y0, y1 - 1)) {
+            if (settings.culling && culled(tr, l, x0, x1 - 1, y0, y1 - 1, true)) {
                 ++cnt.culled_tile;
                 continue;
             }
@@ -1084,6 +1200,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         stats.layer_culled_tile += c.culled_tile;
         stats.layer_culled_ray += c.culled_ray;
         stats.cone_partial += c.cone_partial;
+        stats.cone_missed += c.cone_missed;
         stats.texel_fetches += c.fetches;
         stats.transparent_hits += c.transparent_hits;
     }

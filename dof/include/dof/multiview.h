@@ -119,6 +119,10 @@ struct MultiviewSettings {
     // false runs every stage anyway (for looking at them).
     bool skip_unblurred = true;
     bool cone = true; // §4.4 approximate cone tracing
+    // With cone: a ray that crosses a layer without a hit also looks its cone up there. The
+    // paper evaluates the cone only at an impact point, so rays that pass beside a small or thin
+    // object never see it and the gaps between lens samples stay (false: the paper's rule).
+    bool cone_misses = true;
     JitterMode jitter = JitterMode::None;
     uint32_t seed = 0; // jitter key
     OffscreenPolicy offscreen = OffscreenPolicy::Clamp;
@@ -158,6 +162,7 @@ struct MultiviewStats {
     uint64_t layer_culled_tile = 0;  // (tile, layer) pairs skipped by one query for the tile
     uint64_t layer_culled_ray = 0;   // (ray, layer) pairs skipped by a query on the ray's path
     uint64_t cone_partial = 0;       // hits whose cone coverage v1 < 1 continued the traversal
+    uint64_t cone_missed = 0;        // misses whose cone met coverage v1 > 0 (cone_misses)
     uint64_t texel_fetches = 0;      // height-field lookups
     uint64_t transparent_hits = 0;   // hits on a layer's transparent plane (BLEND surfaces)
     uint64_t path_cells = 0;         // cells of the paths walked once per frame (0: none)
@@ -179,6 +184,9 @@ struct MultiviewScratch {
     // per layer, per level >= 1: premultiplied RGBA (alpha = coverage), level sizes halve
     std::vector<std::vector<std::vector<float>>> mips;
     std::vector<uint32_t> mip_width, mip_height; // per level (level 0 = image)
+    // per layer, per level: (D coverage, coverage) of the layer's depths, for the cones of
+    // missed rays (MultiviewSettings::cone_misses; empty otherwise)
+    std::vector<std::vector<std::vector<float>>> depth_mips;
     // The same for the layers' transparent planes (empty when the scene has no BLEND surface):
     // stored D of the nearest BLEND fragment (kEmptyDepth where none) and premultiplied mipmaps.
     std::vector<std::vector<float>> transparent_depth;

@@ -142,6 +142,33 @@ TEST(Multiview, BlurRadiusMatchesTheLens) {
     EXPECT_NEAR(mv.weight, ref.weight, 0.05 * ref.weight); // energy is preserved
 }
 
+TEST(Multiview, ConesOfMissedRaysKeepASmallLightsEnergy) {
+    // §4.4 looks a cone up only where its centre ray hits: with 16 lens samples most rays pass
+    // beside a small light between the samples, and its blurred image loses energy. Looking up
+    // the cones of missed rays too (cone_misses, the default) keeps it. The square of
+    // BlurRadiusMatchesTheLens (C = 8 px) against accum with 256 views. Measured: energy 4.00
+    // (accum), 0.66 (hits only), 4.00 (with misses); PSNR 48.5 -> 56.5 dB.
+    const raster::View view = pixelView(64, 64, 100.0f);
+    raster::Scene scene;
+    const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
+    addQuad(scene, -2.0f, -2.0f, 2.0f, 2.0f, 200.0f, white);
+    const dof::ThinLens lens = dof::makeThinLens(view, 16.0f, 100.0f);
+    const raster::Frame ref = renderAccum(scene, view, lens, makeSamples(256));
+    const double ref_energy = momentsOf(ref, {32.0, 32.0}).weight;
+    const dof::LensSampleSet samples = makeSamples(16);
+    dof::MultiviewSettings paper;
+    paper.cone_misses = false;
+    const MvRun hits_only = runMultiview(scene, view, lens, samples, paper);
+    const MvRun misses = runMultiview(scene, view, lens, samples, dof::MultiviewSettings{});
+    EXPECT_EQ(hits_only.stats.cone_missed, 0u);
+    EXPECT_GT(misses.stats.cone_missed, 0u);
+    const double e_hits = momentsOf(hits_only.frame, {32.0, 32.0}).weight;
+    const double e_misses = momentsOf(misses.frame, {32.0, 32.0}).weight;
+    EXPECT_NEAR(e_misses, ref_energy, 0.05 * ref_energy);
+    EXPECT_LT(e_hits, 0.9 * ref_energy);
+    EXPECT_GT(psnrDb(ref, misses.frame), psnrDb(ref, hits_only.frame) + 3.0);
+}
+
 TEST(Multiview, ForegroundBlurRevealsHiddenBackground) {
     // A thin near bar in front of the focused wall: the wall behind it shows through (the layers
     // hold the hidden surface, §4.1), so the bar's centre line is mostly wall colour.
