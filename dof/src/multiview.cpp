@@ -58,6 +58,10 @@ struct Hit {
     bool hit = false;
     float t = 0.0f;
     uint32_t texel = 0;
+    // Where the centre ray leaves the solid part of the hit texel's column: a continuation
+    // behind a partially covered cone (§4.4's c2) starts there, so it does not meet the texel
+    // whose coverage was just counted again.
+    float t_behind = 0.0f;
 };
 
 // Image positions along a lens ray are kept relative to its pixel's corner (x, y): the ray is
@@ -106,6 +110,9 @@ struct Tracer {
     glm::vec3 background{0.0f};
 
     float cocOf(float t) const { return coc_a + coc_b * t; }
+    bool inImage(float px, float py) const {
+        return px >= 0.0f && py >= 0.0f && px < float(width) && py < float(height);
+    }
     // The ray's offset from its pixel's corner at stored depth t (PathCell).
     glm::vec2 offsetOf(glm::vec2 w, float t) const {
         const float c = cocOf(t);
@@ -186,7 +193,7 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
         const Sample a = fetch(s0);
         fa = fInterior(s0, a);
         if (a.covered && fa >= 0.0f) // the surface is at or before the segment's start
-            return {true, s0, a.texel};
+            return {true, s0, a.texel, s1};
         b = fetch(s1);
         fb = fFarEnd(*b);
         // Method of false position: intersect the ray with the line through (ta, fa), (tb, fb).
@@ -221,7 +228,7 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
     if (!b)
         b = fetch(tb); // the shortcut's far end, never looked up
     if (b->covered)
-        return {true, tb, b->texel};
+        return {true, tb, b->texel, s1}; // the height field is solid to the segment's end
     return {};
 }
 
@@ -278,7 +285,8 @@ bool scanCell(const Tracer& tr, const float* depth, float seg_near, float s1, ui
     ++cnt.fetches;
     const float h = depth[*texel];
     if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d) {
-        hit = {true, std::clamp(h, t_in, t_out), *texel};
+        const float t = std::clamp(h, t_in, t_out);
+        hit = {true, t, *texel, std::max(t, std::min(h + tr.thickness_d, t_out))};
         return true;
     }
     return false;
@@ -480,60 +488,68 @@ bool boxCulled(const Tracer& tr, uint32_t l, int64_t x0, int64_t x1, int64_t y0,
     return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > tr.segs[l].t1;
 }
 
-// Whether no ray of the pixels [x0, x1] x [y0, y1] can meet a texel of layer l: a ray stays
-// within reach_px of its pixel centre in the layer, so it reads texel offsets within
-// [floor(0.5 - reach), floor(0.5 + reach)] of its pixel (PathCell). With `cones`, whether their
-// missed cones see none either (they read cone_px further): the layer can then be skipped.
+// Whether layer l has no texel within `margin` pixels of what the rays of the pixels
+// [x0, x1] x [y0, y1] cross: a ray stays within reach_px of its pixel centre in the layer, so it
+// reads texel offsets within [floor(0.5 - reach), floor(0.5 + reach)] of its pixel (PathCell).
+// Margin 0: no ray can hit the layer; cone_px: their missed cones see nothing either.
 bool culled(const Tracer& tr, uint32_t l, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
-            bool cones) {
-    const float r = tr.segs[l].reach_px + (cones ? tr.segs[l].cone_px : 0.0f);
+            float margin) {
+    const float r = tr.segs[l].reach_px + margin;
     const int64_t lo = int64_t(std::floor(0.5f - r)), hi = int64_t(std::floor(0.5f + r));
     return boxCulled(tr, l, int64_t(x0) + lo, int64_t(x1) + hi, int64_t(y0) + lo, int64_t(y1) + hi);
 }
 
-// A lens ray that crossed layer l's segment without a hit still has a cone around it (§4.4
-// thickens every ray, so the gaps between lens samples are covered whether or not the centre
-// ray hits). The cone is placed where the ray passes the layer's content: first at the middle
-// of the layer (t_cone), then at the mean depth of the covered texels found there (a small
-// object's image offset C, and so where the ray passes it, depends on its depth). Its coverage
-// v1 and colour c1 enter the continuation v1 c1 + (1 - v1) c2 like a partial hit. Only inside
-// the image (the culling margin cone_px relies on it). Returns whether the cone blocked the ray.
-bool coneMiss(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w, bool shade,
-              glm::vec3 eye, glm::vec3& color, float& transmit, TileCounters& cnt) {
+// A missed ray's cone (MultiviewSettings::cone_misses): coverage v1 and mean colour c1 of the
+// layer texels around the ray where it passes them, at stored depth t.
+struct MissCone {
+    float v1 = 0.0f;
+    glm::vec3 c1{0.0f};
+    float t = 0.0f;
+};
+
+// The paper (§4.4) evaluates a cone only "given an impact point", so rays passing beside a small
+// or thin object between the lens samples never see it. Here a ray that crossed layer l's
+// segment without a hit is thickened too. The cone is placed where the ray passes the layer's
+// content: first at the middle of the layer (t_cone), then at the mean depth of the covered
+// texels found there (where a ray passes a small object depends on the object's depth, through
+// C). Coverage counts only the texels the layer owns ([own0, own1], depth_mips), so a surface in
+// the overlap of two layers is coned once; the colour is the mean of the colour mipmap. Only
+// inside the image (the culling margin cone_px relies on it). None when the cone sees nothing.
+std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w,
+                                 bool shade, glm::vec3 eye, TileCounters& cnt) {
     const LayerSeg& seg = tr.segs[l];
-    auto inside = [&](float px, float py) {
-        return px >= 0.0f && py >= 0.0f && px < float(tr.width) && py < float(tr.height);
-    };
     float c = tr.cocOf(seg.t_cone);
     float px = cx + c * w.x, py = cy + c * w.y;
-    if (!inside(px, py))
-        return false;
+    if (!tr.inImage(px, py))
+        return std::nullopt;
     // Nothing of the layer within the first lookup's reach (one N-buffer query, lossless).
     if (tr.settings->culling &&
         boxCulled(tr, l, int64_t(std::floor(px - seg.cone_px)),
                   int64_t(std::floor(px + seg.cone_px)), int64_t(std::floor(py - seg.cone_px)),
                   int64_t(std::floor(py + seg.cone_px))))
-        return false;
-    const glm::vec2 d =
-        sampleMip<2>(tr, tr.scratch->depth_mips[l], px, py, tr.lambda * std::fabs(c));
+        return std::nullopt;
+    const std::vector<std::vector<float>>& depth_mip = tr.scratch->depth_mips[l];
+    const glm::vec2 d = sampleMip<2>(tr, depth_mip, px, py, tr.lambda * std::fabs(c));
     if (!(d.y > 0.0f))
-        return false;
-    c = tr.cocOf(std::clamp(d.x / d.y, seg.t0, seg.t1));
+        return std::nullopt;
+    MissCone cone;
+    cone.t = std::clamp(d.x / d.y, seg.t0, seg.t1);
+    c = tr.cocOf(cone.t);
     px = cx + c * w.x, py = cy + c * w.y;
     const float diameter = tr.lambda * std::fabs(c);
-    if (!inside(px, py) || !(diameter > 1.0f))
-        return false;
+    if (!tr.inImage(px, py) || !(diameter > 1.0f))
+        return std::nullopt;
+    cone.v1 = std::clamp(sampleMip<2>(tr, depth_mip, px, py, diameter).y, 0.0f, 1.0f);
+    if (!(cone.v1 > 0.0f))
+        return std::nullopt;
     const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], px, py, diameter);
-    const float v1 = std::clamp(m.a, 0.0f, 1.0f);
-    if (!(v1 > 0.0f))
-        return false;
+    if (!(m.a > 0.0f))
+        return std::nullopt;
     ++cnt.cone_missed;
-    glm::vec3 c1 = glm::vec3(m) / m.a;
+    cone.c1 = glm::vec3(m) / m.a;
     if (shade && tr.settings->cone_shading == ConeShading::Footprint)
-        c1 = shadeTaps(tr, l, px, py, 0.5f * diameter, eye).value_or(c1);
-    color += transmit * v1 * c1;
-    transmit = v1 >= kFullCoverage ? 0.0f : transmit * (1.0f - v1);
-    return transmit == 0.0f;
+        cone.c1 = shadeTaps(tr, l, px, py, 0.5f * diameter, eye).value_or(cone.c1);
+    return cone;
 }
 
 // The cells a path from offset o0 to o1 can cross lie in the box of its end cells.
@@ -566,18 +582,19 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
     const MultiviewSettings& s = *tr.settings;
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
     // Layers this pixel's rays or their missed cones can meet (early culling per pixel, §4.3);
-    // bit i of `reach` is set when active[i] can be hit at all (else only its cones matter).
+    // bit i of `hittable` is set when active[i] can be hit at all (else only cones see it).
     std::array<uint32_t, raster::kMaxLayers> active{};
-    uint64_t reach = 0;
+    uint64_t hittable = 0;
     uint32_t active_count = 0;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
         const uint32_t l = tile_layers[i];
-        if (s.culling && culled(tr, l, x, x, y, y, true)) {
+        const float cone_px = tr.segs[l].cone_px;
+        if (s.culling && culled(tr, l, x, x, y, y, cone_px)) {
             ++cnt.culled_pixel;
             continue;
         }
-        if (!s.culling || tr.segs[l].cone_px == 0.0f || !culled(tr, l, x, x, y, y, false))
-            reach |= uint64_t(1) << active_count;
+        if (!s.culling || cone_px == 0.0f || !culled(tr, l, x, x, y, y, 0.0f))
+            hittable |= uint64_t(1) << active_count;
         active[active_count++] = l;
     }
     // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
@@ -641,7 +658,7 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 continue;
             // The whole segment's path walked in advance, unless the ray resumes inside it.
             const RayPath* path = paths && s0 == seg.t0 ? &paths[l] : nullptr;
-            bool can_hit = (reach >> i) & 1;
+            bool can_hit = (hittable >> i) & 1;
             if (can_hit && s.culling && (!path || path->count > kRayCullMinCells)) {
                 // Per-ray culling: the texels this ray's segment can read lie in the box of its
                 // end points; one N-buffer query skips the height-field test when none of them
@@ -669,6 +686,20 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                                     cnt)
                          : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
             }
+            // A ray that crossed the whole segment without a hit still has a cone (missCone),
+            // composited in depth order with the transparent plane.
+            std::optional<MissCone> miss;
+            if (!h.hit && seg.cone_px > 0.0f && s0 == seg.t0)
+                miss = missCone(tr, l, cx, cy, w, shade, shade_from, cnt);
+            auto addMiss = [&] {
+                color += transmit * miss->v1 * miss->c1;
+                transmit = miss->v1 >= kFullCoverage ? 0.0f : transmit * (1.0f - miss->v1);
+                if (transmit == 0.0f)
+                    t_end = miss->t;
+                if (rec)
+                    rec->layer = int32_t(l);
+                miss.reset();
+            };
             // The layer's transparent plane in front of its opaque hit. The plane holds only
             // depths of the layer's own interval (LayerSink routes each BLEND fragment to the
             // one layer owning its depth), so only that part of the segment is searched. Its
@@ -701,6 +732,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                         const float share = texel_a > 0.0f ? std::min(m.a / texel_a, 1.0f) : 0.0f;
                         rgb += share * lt.transparent_top_alpha[ti] * (ray - centre);
                     }
+                    if (miss && miss->t < ht.t)
+                        addMiss();
                     color += transmit * rgb;
                     transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
                     t_end = ht.t;
@@ -709,14 +742,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 }
             }
             if (!h.hit) {
-                // The cone around a ray that crossed the whole segment without a hit.
-                if (seg.cone_px > 0.0f && s0 == seg.t0 &&
-                    coneMiss(tr, l, cx, cy, w, shade, shade_from, color, transmit, cnt)) {
-                    t_end = seg.t_cone;
-                    if (rec)
-                        rec->layer = int32_t(l);
-                    break;
-                }
+                if (miss)
+                    addMiss();
                 continue;
             }
             const float c_hit = tr.cocOf(h.t);
@@ -752,12 +779,7 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                 ++rec->partial_hits;
             color += transmit * v1 * c1;
             transmit *= 1.0f - v1;
-            // Continue behind the solid part of the texel whose coverage was just counted (its
-            // stored depth plus the thickness; the paper's height field is solid to the
-            // layer's end), or the centre ray would hit that texel again.
-            const float solid_end =
-                std::min(tr.scratch->depth[l][h.texel] + tr.thickness_d, seg.t1);
-            t_resume = std::max(h.t, solid_end) + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
+            t_resume = h.t_behind + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
             t_end = h.t;
         }
         if (transmit > 0.0f) {
@@ -1002,22 +1024,22 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         seg.transparent = transparent_content[l] != 0;
         // Every ray of a pixel stays within r_max * max |C| of it over the segment (C is
         // monotonic in D, so the extreme is at an end).
-        seg.reach_px =
-            tr.r_max * std::max(std::fabs(tr.cocOf(seg.t0)), std::fabs(tr.cocOf(seg.t1)));
-        if (settings.cone && settings.cone_misses) {
-            // A missed cone is first looked up in the middle of the layer's own interval,
-            // then somewhere in the segment (coneMiss). A trilinear lookup at diameter Dc reads
-            // level floor(log2 Dc) + 1 at most, 1.5 of its texels either side.
-            seg.t_cone = 0.5f * (seg.own0 + seg.own1);
-            const float widest =
-                tr.lambda * std::max(std::fabs(tr.cocOf(seg.t0)), std::fabs(tr.cocOf(seg.t1)));
-            if (widest > 1.0f)
-                seg.cone_px = 1.5f * std::ldexp(1.0f, std::ilogb(widest) + 1) + 1.0f;
-        }
-        if (!(seg.reach_px < kMaxReachPx))
+        const float coc_max = std::max(std::fabs(tr.cocOf(seg.t0)), std::fabs(tr.cocOf(seg.t1)));
+        seg.reach_px = tr.r_max * coc_max;
+        if (!(seg.reach_px < kMaxReachPx && coc_max < kMaxReachPx))
             return Status::error("multiview: the lens blurs by more than 2^24 pixels over the "
                                  "visible depths (aperture radius " +
                                  std::to_string(lens.aperture_radius) + ")");
+        const float widest = tr.lambda * coc_max;
+        if (settings.cone && settings.cone_misses && widest > 1.0f) {
+            // A missed cone is first looked up in the middle of the layer's own interval,
+            // then somewhere in the segment (missCone). A trilinear lookup at diameter Dc reads
+            // level floor(log2 Dc) + 1 at most (and none above the top), 1.5 of its texels
+            // either side.
+            seg.t_cone = 0.5f * (seg.own0 + seg.own1);
+            const int top = int(kMaxMipLevels) - 1;
+            seg.cone_px = 1.5f * std::ldexp(1.0f, std::min(std::ilogb(widest) + 1, top)) + 1.0f;
+        }
         if (!seg.empty)
             reach_max = std::max(reach_max, seg.reach_px);
         else
@@ -1113,11 +1135,15 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                 const float a = c.a > 0.0f ? 1.0f : 0.0f;
                 return glm::vec4(glm::vec3(c) * a, a);
             });
-            if (settings.cone_misses) // (D a, a): the covered texels' mean depth
+            if (settings.cone_misses) { // (D a, a) over the texels the layer owns (missCone)
+                const float lo = tr.segs[l].own0, hi = tr.segs[l].own1;
+                const bool last = l + 1 == m;
                 build.template operator()<2>(scratch.depth_mips[l], [&](size_t i) {
                     const float d = scratch.depth[l][i];
-                    return d == kEmptyDepth ? glm::vec2(0.0f) : glm::vec2(d, 1.0f);
+                    const bool owned = d >= lo && (d < hi || (last && d <= hi));
+                    return owned ? glm::vec2(d, 1.0f) : glm::vec2(0.0f);
                 });
+            }
             if (transparency) // already premultiplied, alpha = opacity
                 build.template operator()<4>(scratch.transparent_mips[l], [&](size_t i) {
                     return layers.transparent_color.load(layers.index(l, i));
@@ -1180,7 +1206,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         for (uint32_t l = 0; l < m; ++l) {
             if (tr.segs[l].empty)
                 continue;
-            if (settings.culling && culled(tr, l, x0, x1 - 1, y0, y1 - 1, true)) {
+            if (settings.culling && culled(tr, l, x0, x1 - 1, y0, y1 - 1, tr.segs[l].cone_px)) {
                 ++cnt.culled_tile;
                 continue;
             }

@@ -183,23 +183,38 @@ TEST(Multiview, ForegroundBlurRevealsHiddenBackground) {
 }
 
 TEST(Multiview, CullingIsLossless) {
+    // Culling skips the height-field tests and the missed rays' cones only where they cannot
+    // see a texel. A BLEND pane (its own plane, in the N-buffer too), both off-screen policies,
+    // one-pixel layers (short precomputed paths) and two layers (long paths, culled per ray).
     BarCase c = barCase(5.0f, 10.0f);
     addQuad(c.scene, 10.0f, 0.0f, 20.0f, 8.0f, 70.0f, c.green);
+    const int32_t pane =
+        addMaterial(c.scene, flatMaterial({1.0f, 0.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
+    addQuad(c.scene, -5.0f, -20.0f, 5.0f, 20.0f, 80.0f, pane);
     const dof::LensSampleSet samples = makeSamples(24);
     for (dof::Traversal traversal : {dof::Traversal::Scan, dof::Traversal::FalsePosition})
-        for (dof::JitterMode jitter : {dof::JitterMode::None, dof::JitterMode::Noise}) {
-            dof::MultiviewSettings on;
-            on.layer_spacing_px = 1.0f;
-            on.traversal = traversal;
-            on.jitter = jitter; // per-pixel samples: every path is walked per pixel
-            dof::MultiviewSettings off = on;
-            off.culling = false;
-            const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
-            const MvRun b = runMultiview(c.scene, c.view, c.lens, samples, off);
-            EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
-            EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile, 0u);
-            EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
-        }
+        for (dof::JitterMode jitter : {dof::JitterMode::None, dof::JitterMode::Noise})
+            for (dof::OffscreenPolicy offscreen :
+                 {dof::OffscreenPolicy::Clamp, dof::OffscreenPolicy::Discard})
+                for (uint32_t layers : {0u, 2u}) {
+                    dof::MultiviewSettings on;
+                    on.layer_spacing_px = 1.0f;
+                    on.layers = layers;
+                    on.traversal = traversal;
+                    on.jitter = jitter; // per-pixel samples: every path is walked per pixel
+                    on.offscreen = offscreen;
+                    dof::MultiviewSettings off = on;
+                    off.culling = false;
+                    const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
+                    const MvRun b = runMultiview(c.scene, c.view, c.lens, samples, off);
+                    EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
+                    EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile +
+                                  a.stats.layer_culled_ray,
+                              0u);
+                    EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
+                    EXPECT_GT(a.stats.cone_missed, 0u);
+                    EXPECT_EQ(a.stats.cone_missed, b.stats.cone_missed);
+                }
 }
 
 TEST(Multiview, PrecomputedPathsGiveTheSameBytes) {
