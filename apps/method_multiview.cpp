@@ -30,7 +30,7 @@ struct MultiviewArgs {
     uint32_t refine_steps = 4;
     std::string traversal = "scan";
     std::string bound_init = "off";
-    std::string thickness = "2";
+    std::string thickness = "0.5";
     std::string cone = "on";
     std::string cone_misses = "on";
     std::string culling = "on";

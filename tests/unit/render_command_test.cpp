@@ -42,7 +42,7 @@ TEST(RenderCommand, MethodOptionsStartFromTheirDefaultsOnEveryParse) {
     const nlohmann::json second =
         renderStats({"--method", "multiview", "--samples", "4"}, dir.string());
     EXPECT_EQ(second["params"]["layers_requested"], 0);
-    EXPECT_EQ(second["params"]["thickness_px"], "2");
+    EXPECT_EQ(second["params"]["thickness_px"], "0.5");
     const nlohmann::json third =
         renderStats({"--method", "multilayer", "--epsilon", "0.5"}, dir.string());
     const nlohmann::json fourth = renderStats({"--method", "multilayer"}, dir.string());

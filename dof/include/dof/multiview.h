@@ -109,7 +109,9 @@ struct MultiviewSettings {
     // false position needs a closed height field to bracket its crossings), as a CoC difference in
     // pixels (converted to D with Eq. 3). INFINITY is the paper's height field: solid down to the
     // layer's far end, so a ray passing behind a thin object in the same layer stops on it.
-    float thickness_px = 2.0f;
+    // 0.5 px: with the cones of missed rays, thinner was closer to accum on the built-in scenes
+    // than 1 or 2 px at N = 8-64 (docs/benchmarks.md, "Texel thickness").
+    float thickness_px = 0.5f;
     bool culling = true; // §4.3 early layer culling with N-buffers (lossless)
     // With JitterMode::None and Traversal::Scan every pixel's ray k crosses the same cells
     // relative to the pixel, so each (sample, layer) path is walked once per frame instead of
