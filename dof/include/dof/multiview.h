@@ -2,7 +2,8 @@
 // (Lee, Eisemann & Seidel 2009). Consumes a pinhole frame and a raster::LayeredTarget rendered
 // through the lens centre (§4.1-4.2; or render callbacks that produce them), the thin lens and a
 // lens sample set; traces N lens rays per pixel through the layers' height fields (§4.3, Eq. 2-3)
-// with N-buffer culling (§4.3), approximate cone tracing (§4.4), optional jittered lens
+// with N-buffer culling (§4.3), approximate cone tracing (§4.4; also for rays that miss a
+// layer, MultiviewSettings::cone_misses), optional jittered lens
 // sampling (§4.5; the shared set is the default) and optional view-dependent shading per ray
 // (§5). Produces linear RGBA owned by the caller;
 // scratch (N-buffers, mipmaps) lives in the MultiviewScratch the caller may keep between frames.
