@@ -121,19 +121,29 @@ TEST(Multiview, InFocusWallIsUnchanged) {
     }
 }
 
-TEST(Multiview, BlurRadiusMatchesTheLens) {
-    // A 2x2-pixel white square at d = 200 behind the focal plane d_f = 100 on black: its image is
-    // the aperture disc of radius |C(200)| = E f_px (1/100 - 1/200) = 8 px (+ 1 px square).
-    const raster::View view = pixelView(64, 64, 100.0f);
+// A 2x2-pixel white square at d = 200 behind the focal plane d_f = 100 on black, seen by a 64x64
+// view (f_px 100): its image is the aperture disc of radius |C(200)| = E f_px (1/100 - 1/200) =
+// 8 px (+ 1 px square).
+struct SquareCase {
+    raster::View view = pixelView(64, 64, 100.0f);
     raster::Scene scene;
-    const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
-    addQuad(scene, -2.0f, -2.0f, 2.0f, 2.0f, 200.0f, white);
-    const dof::ThinLens lens = dof::makeThinLens(view, 16.0f, 100.0f);
-    ASSERT_NEAR(dof::cocRadiusPx(lens, 200.0f), 8.0f, 1e-4f);
+    dof::ThinLens lens;
+};
+SquareCase squareCase() {
+    SquareCase c;
+    const int32_t white = addMaterial(c.scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
+    addQuad(c.scene, -2.0f, -2.0f, 2.0f, 2.0f, 200.0f, white);
+    c.lens = dof::makeThinLens(c.view, 16.0f, 100.0f);
+    return c;
+}
+
+TEST(Multiview, BlurRadiusMatchesTheLens) {
+    const SquareCase c = squareCase();
+    ASSERT_NEAR(dof::cocRadiusPx(c.lens, 200.0f), 8.0f, 1e-4f);
     const dof::LensSampleSet samples = makeSamples(256);
-    const MvRun run = runMultiview(scene, view, lens, samples, exactSettings());
+    const MvRun run = runMultiview(c.scene, c.view, c.lens, samples, exactSettings());
     const Moments mv = momentsOf(run.frame, {32.0, 32.0});
-    const Moments ref = momentsOf(renderAccum(scene, view, lens, samples), {32.0, 32.0});
+    const Moments ref = momentsOf(renderAccum(c.scene, c.view, c.lens, samples), {32.0, 32.0});
     EXPECT_GT(mv.max_r, 7.5);
     EXPECT_LT(mv.max_r, 10.0);
     EXPECT_NEAR(mv.max_r, ref.max_r, 1.0);
@@ -148,18 +158,14 @@ TEST(Multiview, ConesOfMissedRaysKeepASmallLightsEnergy) {
     // the cones of missed rays too (cone_misses, the default) keeps it. The square of
     // BlurRadiusMatchesTheLens (C = 8 px) against accum with 256 views. Measured: energy 4.00
     // (accum), 0.66 (hits only), 4.00 (with misses); PSNR 48.5 -> 56.5 dB.
-    const raster::View view = pixelView(64, 64, 100.0f);
-    raster::Scene scene;
-    const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
-    addQuad(scene, -2.0f, -2.0f, 2.0f, 2.0f, 200.0f, white);
-    const dof::ThinLens lens = dof::makeThinLens(view, 16.0f, 100.0f);
-    const raster::Frame ref = renderAccum(scene, view, lens, makeSamples(256));
+    const SquareCase c = squareCase();
+    const raster::Frame ref = renderAccum(c.scene, c.view, c.lens, makeSamples(256));
     const double ref_energy = momentsOf(ref, {32.0, 32.0}).weight;
     const dof::LensSampleSet samples = makeSamples(16);
     dof::MultiviewSettings paper;
     paper.cone_misses = false;
-    const MvRun hits_only = runMultiview(scene, view, lens, samples, paper);
-    const MvRun misses = runMultiview(scene, view, lens, samples, dof::MultiviewSettings{});
+    const MvRun hits_only = runMultiview(c.scene, c.view, c.lens, samples, paper);
+    const MvRun misses = runMultiview(c.scene, c.view, c.lens, samples, dof::MultiviewSettings{});
     EXPECT_EQ(hits_only.stats.cone_missed, 0u);
     EXPECT_GT(misses.stats.cone_missed, 0u);
     const double e_hits = momentsOf(hits_only.frame, {32.0, 32.0}).weight;
@@ -182,15 +188,22 @@ TEST(Multiview, ForegroundBlurRevealsHiddenBackground) {
     EXPECT_NEAR(m.g, r.g, 0.08f);
 }
 
-TEST(Multiview, CullingIsLossless) {
-    // Culling skips the height-field tests and the missed rays' cones only where they cannot
-    // see a texel. A BLEND pane (its own plane, in the N-buffer too), both off-screen policies,
-    // one-pixel layers (short precomputed paths) and two layers (long paths, culled per ray).
+// barCase(5, 10) with a second bar at d = 70 and a half-transparent BLEND pane at d = 80: two
+// layers of opaque content, partial cone hits, missed cones and a transparent plane.
+BarCase barsAndPane() {
     BarCase c = barCase(5.0f, 10.0f);
     addQuad(c.scene, 10.0f, 0.0f, 20.0f, 8.0f, 70.0f, c.green);
     const int32_t pane =
         addMaterial(c.scene, flatMaterial({1.0f, 0.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
     addQuad(c.scene, -5.0f, -20.0f, 5.0f, 20.0f, 80.0f, pane);
+    return c;
+}
+
+TEST(Multiview, CullingIsLossless) {
+    // Culling skips the height-field tests and the missed rays' cones only where they cannot
+    // see a texel. A BLEND pane (its own plane, in the N-buffer too), both off-screen policies,
+    // one-pixel layers (short precomputed paths) and two layers (long paths, culled per ray).
+    const BarCase c = barsAndPane();
     const dof::LensSampleSet samples = makeSamples(24);
     for (dof::Traversal traversal : {dof::Traversal::Scan, dof::Traversal::FalsePosition})
         for (dof::JitterMode jitter : {dof::JitterMode::None, dof::JitterMode::Noise})
@@ -223,11 +236,7 @@ TEST(Multiview, PrecomputedPathsGiveTheSameBytes) {
     // partial cone hits (rays resuming inside a layer take the per-pixel walk), a BLEND pane,
     // short paths (delta = 1 px) and long ones (two layers, culled per ray), both off-screen
     // policies.
-    BarCase c = barCase(5.0f, 10.0f);
-    addQuad(c.scene, 10.0f, 0.0f, 20.0f, 8.0f, 70.0f, c.green);
-    const int32_t pane =
-        addMaterial(c.scene, flatMaterial({1.0f, 0.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
-    addQuad(c.scene, -5.0f, -20.0f, 5.0f, 20.0f, 80.0f, pane);
+    const BarCase c = barsAndPane();
     const dof::LensSampleSet samples = makeSamples(24);
     for (dof::OffscreenPolicy offscreen :
          {dof::OffscreenPolicy::Discard, dof::OffscreenPolicy::Clamp})
