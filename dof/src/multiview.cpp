@@ -513,14 +513,29 @@ struct MissCone {
 // content: first at the middle of the layer (t_cone), then at the mean depth of the covered
 // texels found there (where a ray passes a small object depends on the object's depth, through
 // C). Coverage counts only the texels the layer owns ([own0, own1], depth_mips), so a surface in
-// the overlap of two layers is coned once; the colour is the mean of the colour mipmap. Only
-// inside the image (the culling margin cone_px relies on it). None when the cone sees nothing.
+// the overlap of two layers is coned once; the colour is the mean of the colour mipmap. Off the
+// image the cone is looked up at the image border under OffscreenPolicy::Clamp (the border
+// texels stand in for the unseen content, as for a clamped hit) and not at all under Discard;
+// the culling windows, clamped to the image, then still hold every texel read. None when the
+// cone sees nothing.
 std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w,
                                  bool shade, glm::vec3 eye, TileCounters& cnt) {
     const LayerSeg& seg = tr.segs[l];
-    float c = tr.cocOf(seg.t_cone);
-    float px = cx + c * w.x, py = cy + c * w.y;
-    if (!tr.inImage(px, py))
+    // Where the ray is at stored depth t: off the image, clamped to its border (as a clamped
+    // ray reads the border texels, OffscreenPolicy::Clamp) or none (Discard).
+    auto at = [&](float t, float& px, float& py) {
+        const float c = tr.cocOf(t);
+        px = cx + c * w.x, py = cy + c * w.y;
+        if (tr.inImage(px, py))
+            return true;
+        if (tr.settings->offscreen != OffscreenPolicy::Clamp)
+            return false;
+        px = std::clamp(px, 0.0f, std::nextafter(float(tr.width), 0.0f));
+        py = std::clamp(py, 0.0f, std::nextafter(float(tr.height), 0.0f));
+        return true;
+    };
+    float px = 0.0f, py = 0.0f;
+    if (!at(seg.t_cone, px, py))
         return std::nullopt;
     // Nothing of the layer within the first lookup's reach (one N-buffer query, lossless).
     if (tr.settings->culling &&
@@ -529,15 +544,14 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
                   int64_t(std::floor(py + seg.cone_px))))
         return std::nullopt;
     const std::vector<std::vector<float>>& depth_mip = tr.scratch->depth_mips[l];
-    const glm::vec2 d = sampleMip<2>(tr, depth_mip, px, py, tr.lambda * std::fabs(c));
+    const glm::vec2 d =
+        sampleMip<2>(tr, depth_mip, px, py, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
     if (!(d.y > 0.0f))
         return std::nullopt;
     MissCone cone;
     cone.t = std::clamp(d.x / d.y, seg.t0, seg.t1);
-    c = tr.cocOf(cone.t);
-    px = cx + c * w.x, py = cy + c * w.y;
-    const float diameter = tr.lambda * std::fabs(c);
-    if (!tr.inImage(px, py) || !(diameter > 1.0f))
+    const float diameter = tr.lambda * std::fabs(tr.cocOf(cone.t));
+    if (!at(cone.t, px, py) || !(diameter > 1.0f))
         return std::nullopt;
     cone.v1 = std::clamp(sampleMip<2>(tr, depth_mip, px, py, diameter).y, 0.0f, 1.0f);
     if (!(cone.v1 > 0.0f))
