@@ -26,6 +26,8 @@ double msSince(Clock::time_point t0) {
 constexpr float kEmptyDepth = 2.0f;
 // Cone coverage at or above this ends the traversal (the cone is fully blocked, §4.4).
 constexpr float kFullCoverage = 0.999f;
+// Channels of MultiviewScratch::owned_mips: D a, a, r a, g a, b a.
+constexpr int kOwnedChannels = 5;
 // Most mip levels built for cone tracing (a 256-pixel cone diameter).
 constexpr uint32_t kMaxMipLevels = 8;
 // Most cells walked in advance (RayPath; 16 bytes each).
@@ -58,9 +60,10 @@ struct Hit {
     bool hit = false;
     float t = 0.0f;
     uint32_t texel = 0;
-    // Where the centre ray leaves the solid part of the hit texel's column: a continuation
-    // behind a partially covered cone (§4.4's c2) starts there, so it does not meet the texel
-    // whose coverage was just counted again.
+    // Where the centre ray leaves the solid slab of the surface it hit (its depth plus the
+    // thickness; the paper's height field is solid to the segment's end): a continuation behind
+    // a partially covered cone (§4.4's c2) starts there, so it does not meet the surface whose
+    // coverage was just counted again (in this layer's neighbours or the next layer's overlap).
     float t_behind = 0.0f;
 };
 
@@ -286,7 +289,7 @@ bool scanCell(const Tracer& tr, const float* depth, float seg_near, float s1, ui
     const float h = depth[*texel];
     if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d) {
         const float t = std::clamp(h, t_in, t_out);
-        hit = {true, t, *texel, std::max(t, std::min(h + tr.thickness_d, t_out))};
+        hit = {true, t, *texel, std::max(t, std::min(h + tr.thickness_d, s1))};
         return true;
     }
     return false;
@@ -314,12 +317,11 @@ Hit scanPath(const Tracer& tr, const float* depth, float seg_near, float s1, uin
     return hit;
 }
 
-// Trilinear lookup of a layer mipmap `mip` with C channels per texel (§4.4) at image position
-// (px, py) for a window of `diameter` pixels.
-template <int C>
-glm::vec<C, float> sampleMip(const Tracer& tr, const std::vector<std::vector<float>>& mip, float px,
-                             float py, float diameter) {
-    using Vec = glm::vec<C, float>;
+// Trilinear lookup of the first C channels of a layer mipmap `mip` with Stride channels per
+// texel (§4.4) at image position (px, py) for a window of `diameter` pixels.
+template <int C, int Stride = C>
+std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<float>>& mip,
+                               float px, float py, float diameter) {
     const MultiviewScratch& sc = *tr.scratch;
     const uint32_t top = uint32_t(sc.mip_width.size()) - 1;
     const float level = std::clamp(std::log2(std::max(diameter, 1.0f)), 0.0f, float(top));
@@ -337,30 +339,32 @@ glm::vec<C, float> sampleMip(const Tracer& tr, const std::vector<std::vector<flo
         // clamped ray read a border texel).
         const int64_t iu = int64_t(std::clamp(fu, -1.0f, float(w)));
         const int64_t iv = int64_t(std::clamp(fv, -1.0f, float(h)));
-        const int64_t x0 = std::clamp<int64_t>(iu, 0, w - 1);
-        const int64_t x1 = std::clamp<int64_t>(iu + 1, 0, w - 1);
-        const float* r0 = img.data() + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * C;
-        const float* r1 = img.data() + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * C;
-        auto at = [](const float* row, int64_t x) {
-            Vec t;
-            for (int c = 0; c < C; ++c)
-                t[c] = row[x * C + c];
-            return t;
-        };
-        const Vec top_row = at(r0, x0) * (1.0f - au) + at(r0, x1) * au;
-        const Vec bottom = at(r1, x0) * (1.0f - au) + at(r1, x1) * au;
-        return top_row * (1.0f - av) + bottom * av;
+        const int64_t x0 = std::clamp<int64_t>(iu, 0, w - 1) * Stride;
+        const int64_t x1 = std::clamp<int64_t>(iu + 1, 0, w - 1) * Stride;
+        const float* r0 = img.data() + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * Stride;
+        const float* r1 = img.data() + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * Stride;
+        std::array<float, C> out;
+        for (int c = 0; c < C; ++c) {
+            const float top_row = r0[x0 + c] * (1.0f - au) + r0[x1 + c] * au;
+            const float bottom = r1[x0 + c] * (1.0f - au) + r1[x1 + c] * au;
+            out[c] = top_row * (1.0f - av) + bottom * av;
+        }
+        return out;
     };
-    const Vec c0 = bilinear(l0);
+    std::array<float, C> c0 = bilinear(l0);
     if (l1 == l0 || f == 0.0f)
         return c0;
-    return c0 * (1.0f - f) + bilinear(l1) * f;
+    const std::array<float, C> c1 = bilinear(l1);
+    for (int c = 0; c < C; ++c)
+        c0[c] = c0[c] * (1.0f - f) + c1[c] * f;
+    return c0;
 }
 
 // A layer's premultiplied coverage mipmap (RGBA, alpha = coverage) at a cone (§4.4).
 glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mip, float px,
                      float py, float diameter) {
-    return sampleMip<4>(tr, mip, px, py, diameter);
+    const std::array<float, 4> m = sampleMip<4>(tr, mip, px, py, diameter);
+    return {m[0], m[1], m[2], m[3]};
 }
 
 glm::vec3 envLookup(const EnvironmentMap& env, glm::vec3 dir) {
@@ -512,8 +516,9 @@ struct MissCone {
 // segment without a hit is thickened too. The cone is placed where the ray passes the layer's
 // content: first at the middle of the layer (t_cone), then at the mean depth of the covered
 // texels found there (where a ray passes a small object depends on the object's depth, through
-// C). Coverage counts only the texels the layer owns ([own0, own1], depth_mips), so a surface in
-// the overlap of two layers is coned once; the colour is the mean of the colour mipmap. Off the
+// C). Coverage and colour count only the texels the layer owns ([own0, own1], owned_mips), so a
+// surface in the overlap of two layers is coned once (per-ray shading, §5, shades the covered
+// texels among the footprint's taps, as for a hit). Off the
 // image the cone is looked up at the image border under OffscreenPolicy::Clamp (the border
 // texels stand in for the unseen content, as for a clamped hit) and not at all under Discard;
 // the culling windows, clamped to the image, then still hold every texel read. None when the
@@ -543,24 +548,23 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
                   int64_t(std::floor(px + seg.cone_px)), int64_t(std::floor(py - seg.cone_px)),
                   int64_t(std::floor(py + seg.cone_px))))
         return std::nullopt;
-    const std::vector<std::vector<float>>& depth_mip = tr.scratch->depth_mips[l];
-    const glm::vec2 d =
-        sampleMip<2>(tr, depth_mip, px, py, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
-    if (!(d.y > 0.0f))
+    const std::vector<std::vector<float>>& owned = tr.scratch->owned_mips[l];
+    const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(
+        tr, owned, px, py, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
+    if (!(d[1] > 0.0f))
         return std::nullopt;
     MissCone cone;
-    cone.t = std::clamp(d.x / d.y, seg.t0, seg.t1);
+    cone.t = std::clamp(d[0] / d[1], seg.t0, seg.t1);
     const float diameter = tr.lambda * std::fabs(tr.cocOf(cone.t));
     if (!at(cone.t, px, py) || !(diameter > 1.0f))
         return std::nullopt;
-    cone.v1 = std::clamp(sampleMip<2>(tr, depth_mip, px, py, diameter).y, 0.0f, 1.0f);
-    if (!(cone.v1 > 0.0f))
-        return std::nullopt;
-    const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], px, py, diameter);
-    if (!(m.a > 0.0f))
+    const std::array<float, kOwnedChannels> m =
+        sampleMip<kOwnedChannels>(tr, owned, px, py, diameter);
+    if (!(m[1] > 0.0f))
         return std::nullopt;
     ++cnt.cone_missed;
-    cone.c1 = glm::vec3(m) / m.a;
+    cone.v1 = std::min(m[1], 1.0f);
+    cone.c1 = glm::vec3(m[2], m[3], m[4]) / m[1];
     if (shade && tr.settings->cone_shading == ConeShading::Footprint)
         cone.c1 = shadeTaps(tr, l, px, py, 0.5f * diameter, eye).value_or(cone.c1);
     return cone;
@@ -662,6 +666,18 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                              : view.eye;
         glm::vec3 color(0.0f);
         float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4)
+        // §4.4: a cone of coverage v1 and colour c1 gives v1 c1 + (1 - v1) c2, c2 what the rest
+        // of the ray sees; from kFullCoverage on it blocks the ray (returns true).
+        auto blend = [&](float v1, glm::vec3 c1) {
+            if (v1 >= kFullCoverage) {
+                color += transmit * c1;
+                transmit = 0.0f;
+                return true;
+            }
+            color += transmit * v1 * c1;
+            transmit *= 1.0f - v1;
+            return false;
+        };
         float t_resume = -1.0f;
         float t_end = t_last;
         for (uint32_t i = 0; i < active_count && transmit > 0.0f; ++i) {
@@ -706,9 +722,7 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             if (!h.hit && seg.cone_px > 0.0f && s0 == seg.t0)
                 miss = missCone(tr, l, cx, cy, w, shade, shade_from, cnt);
             auto addMiss = [&] {
-                color += transmit * miss->v1 * miss->c1;
-                transmit = miss->v1 >= kFullCoverage ? 0.0f : transmit * (1.0f - miss->v1);
-                if (transmit == 0.0f)
+                if (blend(miss->v1, miss->c1))
                     t_end = miss->t;
                 if (rec)
                     rec->layer = int32_t(l);
@@ -723,7 +737,9 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
             if (can_hit && seg.transparent && ta < tb) {
                 const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
-                if (ht.hit) {
+                if (ht.hit && miss && miss->t < ht.t)
+                    addMiss(); // the missed cone's content lies in front of the pane
+                if (ht.hit && transmit > 0.0f) {
                     ++cnt.transparent_hits;
                     const float ct = tr.cocOf(ht.t);
                     const glm::vec4 m =
@@ -746,8 +762,6 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                         const float share = texel_a > 0.0f ? std::min(m.a / texel_a, 1.0f) : 0.0f;
                         rgb += share * lt.transparent_top_alpha[ti] * (ray - centre);
                     }
-                    if (miss && miss->t < ht.t)
-                        addMiss();
                     color += transmit * rgb;
                     transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
                     t_end = ht.t;
@@ -781,18 +795,14 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                          : shadeHit(tr, l, h.texel, h.t, shade_from);
             if (rec)
                 rec->layer = int32_t(l);
-            if (v1 >= kFullCoverage) {
-                color += transmit * c1;
-                transmit = 0.0f;
+            if (blend(v1, c1)) {
                 t_end = h.t;
                 break;
             }
-            // v1 c1 + (1 - v1) c2: continue along the centre ray for c2.
+            // Continue along the centre ray for c2.
             ++cnt.cone_partial;
             if (rec)
                 ++rec->partial_hits;
-            color += transmit * v1 * c1;
-            transmit *= 1.0f - v1;
             t_resume = h.t_behind + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
             t_end = h.t;
         }
@@ -1092,7 +1102,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     t0 = Clock::now();
     scratch.mips.assign(m, {});
     scratch.transparent_mips.assign(transparency ? m : 0, {});
-    scratch.depth_mips.assign(settings.cone && settings.cone_misses ? m : 0, {});
+    scratch.owned_mips.assign(settings.cone && settings.cone_misses ? m : 0, {});
     scratch.mip_width.clear();
     scratch.mip_height.clear();
     if (settings.cone) {
@@ -1115,7 +1125,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             mip.resize(levels);
             mip[0].resize(pixels * C);
             for (size_t i = 0; i < pixels; ++i) {
-                const glm::vec<C, float> c = level0(i);
+                const auto c = level0(i);
                 for (uint32_t k = 0; k < C; ++k)
                     mip[0][i * C + k] = c[k];
             }
@@ -1149,13 +1159,15 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                 const float a = c.a > 0.0f ? 1.0f : 0.0f;
                 return glm::vec4(glm::vec3(c) * a, a);
             });
-            if (settings.cone_misses) { // (D a, a) over the texels the layer owns (missCone)
+            if (settings.cone_misses) { // the texels the layer owns (missCone)
                 const float lo = tr.segs[l].own0, hi = tr.segs[l].own1;
                 const bool last = l + 1 == m;
-                build.template operator()<2>(scratch.depth_mips[l], [&](size_t i) {
+                build.template operator()<kOwnedChannels>(scratch.owned_mips[l], [&](size_t i) {
                     const float d = scratch.depth[l][i];
                     const bool owned = d >= lo && (d < hi || (last && d <= hi));
-                    return owned ? glm::vec2(d, 1.0f) : glm::vec2(0.0f);
+                    const glm::vec4 c = layers.color.load(layers.index(l, i));
+                    return owned ? std::array<float, kOwnedChannels>{d, 1.0f, c.r, c.g, c.b}
+                                 : std::array<float, kOwnedChannels>{};
                 });
             }
             if (transparency) // already premultiplied, alpha = opacity
@@ -1170,8 +1182,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             stats.scratch_bytes += lv.size() * sizeof(float);
         for (const std::vector<float>& lv : scratch.mips[l])
             stats.scratch_bytes += lv.size() * sizeof(float);
-        if (!scratch.depth_mips.empty())
-            for (const std::vector<float>& lv : scratch.depth_mips[l])
+        if (!scratch.owned_mips.empty())
+            for (const std::vector<float>& lv : scratch.owned_mips[l])
                 stats.scratch_bytes += lv.size() * sizeof(float);
         stats.scratch_bytes += scratch.depth[l].size() * sizeof(float);
         if (transparency) {

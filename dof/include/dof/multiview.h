@@ -110,8 +110,9 @@ struct MultiviewSettings {
     // false position needs a closed height field to bracket its crossings), as a CoC difference in
     // pixels (converted to D with Eq. 3). INFINITY is the paper's height field: solid down to the
     // layer's far end, so a ray passing behind a thin object in the same layer stops on it.
-    // 0.5 px: with the cones of missed rays, thinner was closer to accum on the built-in scenes
-    // than 1 or 2 px at N = 8-64 (docs/benchmarks.md, "Texel thickness").
+    // 0.5 px: with the cones of missed rays, thinner was closer to accum than 1 or 2 px at
+    // N = 8-64 on six of the eight built-in scenes, about equal on railing and dense
+    // (docs/benchmarks.md, "Cones of missed rays and texel thickness").
     float thickness_px = 0.5f;
     bool culling = true; // §4.3 early layer culling with N-buffers (lossless)
     // With JitterMode::None and Traversal::Scan every pixel's ray k crosses the same cells
@@ -187,9 +188,10 @@ struct MultiviewScratch {
     // per layer, per level >= 1: premultiplied RGBA (alpha = coverage), level sizes halve
     std::vector<std::vector<std::vector<float>>> mips;
     std::vector<uint32_t> mip_width, mip_height; // per level (level 0 = image)
-    // per layer, per level: (D coverage, coverage) of the layer's depths, for the cones of
-    // missed rays (MultiviewSettings::cone_misses; empty otherwise)
-    std::vector<std::vector<std::vector<float>>> depth_mips;
+    // per layer, per level: (D a, a, r a, g a, b a) over the texels the layer owns (a = 1 where
+    // its depth lies in the layer's own interval, else 0), for the cones of missed rays
+    // (MultiviewSettings::cone_misses; empty otherwise)
+    std::vector<std::vector<std::vector<float>>> owned_mips;
     // The same for the layers' transparent planes (empty when the scene has no BLEND surface):
     // stored D of the nearest BLEND fragment (kEmptyDepth where none) and premultiplied mipmaps.
     std::vector<std::vector<float>> transparent_depth;
