@@ -122,7 +122,8 @@ glm::uvec2 tileOrigin(uint32_t i, uint32_t tw, uint32_t th, uint32_t cols) {
 // PREFIX_nbuffer.png (N-buffer levels of the nearest layer the pixel's rays hit: min depth as
 // grey, §4.3), PREFIX_rays.png
 // (the traced rays of one pixel over the output, ending in their hit layer's colour) and
-// PREFIX_lens.png (the pixel's lens samples coloured by the layer they hit).
+// PREFIX_lens.png (the pixel's lens samples coloured by the layer they hit, with a white rim
+// where a partial or missed cone gave part of the colour).
 raster::Status writeDebugPictures(const std::string& prefix, const raster::View& view,
                                   const raster::LayeredTarget& lt, const std::vector<float>& out,
                                   const std::vector<dof::MultiviewRayRecord>& rays, uint32_t px,
@@ -237,9 +238,12 @@ raster::Status writeDebugPictures(const std::string& prefix, const raster::View&
             if (glm::dot(v, v) <= 1.0f)
                 lens.set(x, y, glm::vec3(0.2f));
         }
-    for (const dof::MultiviewRayRecord& r : rays)
-        lens.dot(glm::vec2(120.5f + 110.0f * r.lens.x, 120.5f - 110.0f * r.lens.y), 3,
-                 r.discarded ? glm::vec3(1.0f, 0.0f, 0.0f) : layerColour(r.layer));
+    for (const dof::MultiviewRayRecord& r : rays) {
+        const glm::vec2 at(120.5f + 110.0f * r.lens.x, 120.5f - 110.0f * r.lens.y);
+        if (r.partial_hits + r.missed_cones > 0) // part of its colour came from a cone (§4.4)
+            lens.dot(at, 4, glm::vec3(1.0f));
+        lens.dot(at, 3, r.discarded ? glm::vec3(1.0f, 0.0f, 0.0f) : layerColour(r.layer));
+    }
     return lens.write(prefix + "_lens.png");
 }
 

@@ -724,8 +724,10 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             auto addMiss = [&] {
                 if (blend(miss->v1, miss->c1))
                     t_end = miss->t;
-                if (rec)
+                if (rec) {
                     rec->layer = int32_t(l);
+                    ++rec->missed_cones;
+                }
                 miss.reset();
             };
             // The layer's transparent plane in front of its opaque hit. The plane holds only

@@ -90,6 +90,7 @@ struct MultiviewRayRecord {
     glm::vec2 end_px{0.0f};    // image position at t_end
     int32_t layer = -1;        // layer of the hit that ended it; -1: background
     uint32_t partial_hits = 0; // cone hits with coverage < 1 passed through (§4.4)
+    uint32_t missed_cones = 0; // layers missed whose cone saw something (cone_misses)
     bool discarded = false;    // left the image (OffscreenPolicy::Discard)
 };
 

@@ -492,6 +492,19 @@ TEST(Multiview, DebugRaysRecordOnePixelWithoutChangingTheImage) {
     EXPECT_GE(
         std::count_if(per_layer.begin(), per_layer.end(), [](uint32_t hits) { return hits > 0; }),
         2);
+    // With cones, rays passing beside the bar record the missed cones that saw it.
+    dof::MultiviewSettings cones;
+    cones.debug_x = 8;
+    cones.debug_y = 21;
+    cones.debug_rays = &rays;
+    const MvRun coned = runMultiview(c.scene, c.view, c.lens, samples, cones, 2);
+    cones.debug_rays = nullptr;
+    EXPECT_EQ(hashFloats(coned.frame.color),
+              hashFloats(runMultiview(c.scene, c.view, c.lens, samples, cones).frame.color));
+    uint32_t missed = 0;
+    for (const dof::MultiviewRayRecord& r : rays)
+        missed += r.missed_cones;
+    EXPECT_GT(missed, 0u);
 }
 
 TEST(Multiview, SameBytesForEveryThreadCount) {
