@@ -518,11 +518,10 @@ struct MissCone {
 // texels found there (where a ray passes a small object depends on the object's depth, through
 // C). Coverage and colour count only the texels the layer owns ([own0, own1], owned_mips), so a
 // surface in the overlap of two layers is coned once (per-ray shading, §5, shades the covered
-// texels among the footprint's taps, as for a hit). Off the
-// image the cone is looked up at the image border under OffscreenPolicy::Clamp (the border
-// texels stand in for the unseen content, as for a clamped hit) and not at all under Discard;
-// the culling windows, clamped to the image, then still hold every texel read. None when the
-// cone sees nothing.
+// texels among the footprint's taps, as for a hit). Off the image the cone is looked up at the
+// image border under OffscreenPolicy::Clamp (the border texels stand in for the unseen content,
+// as for a clamped hit) and not at all under Discard; the culling windows, clamped to the
+// image, then still hold every texel read. None when the cone sees nothing.
 std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w,
                                  bool shade, glm::vec3 eye, TileCounters& cnt) {
     const LayerSeg& seg = tr.segs[l];

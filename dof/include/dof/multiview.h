@@ -3,10 +3,10 @@
 // through the lens centre (§4.1-4.2; or render callbacks that produce them), the thin lens and a
 // lens sample set; traces N lens rays per pixel through the layers' height fields (§4.3, Eq. 2-3)
 // with N-buffer culling (§4.3), approximate cone tracing (§4.4; also for rays that miss a
-// layer, MultiviewSettings::cone_misses), optional jittered lens
-// sampling (§4.5; the shared set is the default) and optional view-dependent shading per ray
-// (§5). Produces linear RGBA owned by the caller;
-// scratch (N-buffers, mipmaps) lives in the MultiviewScratch the caller may keep between frames.
+// layer, MultiviewSettings::cone_misses), optional jittered lens sampling (§4.5; the shared set
+// is the default) and optional view-dependent shading per ray (§5). Produces linear RGBA owned
+// by the caller; scratch (N-buffers, mipmaps) lives in the MultiviewScratch the caller may keep
+// between frames.
 //
 // Determinism: the image is split into tiles; each output pixel is computed by one task, its
 // rays traced in sample order and summed in a fixed order; counters are summed per tile, then in
