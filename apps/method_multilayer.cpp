@@ -9,6 +9,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -22,11 +23,24 @@ struct MultilayerArgs {
     std::string stack_levels = "auto";
     std::string truncate = "on";
     std::string blend = "additive";
+    std::string filter = "aperture";
+    std::string merge_depth = "mean";
+    std::string additive_gap = "1";
     std::string levels_out; // prefix of the per-level contribution images (Fig. 7)
 };
 
 const char* kindName(dof::LevelKind k) {
-    return k == dof::LevelKind::Base ? "base" : (k == dof::LevelKind::Mip ? "mip" : "stack");
+    switch (k) {
+    case dof::LevelKind::Base:
+        return "base";
+    case dof::LevelKind::Mip:
+        return "mip";
+    case dof::LevelKind::Stack:
+        return "stack";
+    case dof::LevelKind::Aperture:
+        return "aperture";
+    }
+    return "?";
 }
 
 // Per-axis second moment of the aperture from the lens samples when there are enough of them to
@@ -61,6 +75,22 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     }
     settings.truncate = args.truncate == "on";
     settings.blend = args.blend == "additive" ? dof::LayerBlend::Additive : dof::LayerBlend::Over;
+    settings.filter =
+        args.filter == "aperture" ? dof::LevelFilter::Aperture : dof::LevelFilter::Box;
+    if (in.aperture)
+        settings.aperture = *in.aperture;
+    settings.mean_depth = args.merge_depth == "mean";
+    if (args.additive_gap == "inf") {
+        settings.additive_gap = std::numeric_limits<float>::infinity();
+    } else {
+        const char* first = args.additive_gap.data();
+        const char* last = first + args.additive_gap.size();
+        const std::from_chars_result r = std::from_chars(first, last, settings.additive_gap);
+        if (r.ec != std::errc() || r.ptr != last || !(settings.additive_gap >= 0.0f))
+            return raster::Status::error("--additive-gap must be a relative depth gap >= 0 or "
+                                         "'inf', got '" +
+                                         args.additive_gap + "'");
+    }
     settings.color_format = in.target_color.value_or(raster::ColorFormat::Half);
     settings.depth_format = in.target_depth.value_or(raster::DepthFormat::Float32);
     settings.aperture_second_moment = apertureSecondMoment(in.lens_samples);
@@ -110,27 +140,47 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
         {"epsilon", settings.epsilon},
         {"truncate", settings.truncate},
         {"blend", args.blend},
-        {"aperture_second_moment", settings.aperture_second_moment},
+        {"level_filter", args.filter},
+        {"merge_depth", args.merge_depth},
+        {"additive_gap", args.additive_gap},
+        {"aperture_grids", settings.aperture_grids},
+        {"second_moment", st.second_moment},
         {"color_format", settings.color_format == raster::ColorFormat::Half ? "half" : "float32"},
         {"depth_format",
          settings.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"}};
+    auto levelJson = [](const dof::MultilayerLevelStats& l) {
+        nlohmann::json j = {{"level", l.index},
+                            {"kind", kindName(l.kind)},
+                            {"width", l.width},
+                            {"height", l.height},
+                            {"dilation", l.dilation},
+                            {"fragments", l.fragments},
+                            {"max_list_length", l.max_list_length},
+                            {"mean_list_length", l.mean_list_length},
+                            {"truncated", l.truncated}};
+        if (l.kind == dof::LevelKind::Aperture) {
+            j["source"] = l.source;
+            j["grid"] = l.grid;
+        }
+        return j;
+    };
     nlohmann::json levels = nlohmann::json::array();
-    for (const dof::MultilayerLevelStats& l : st.levels) {
+    for (const dof::MultilayerLevelStats& l : st.levels)
+        levels.push_back(levelJson(l));
+    nlohmann::json apertures = nlohmann::json::array();
+    for (const dof::MultilayerLevelStats& l : st.apertures)
+        apertures.push_back(levelJson(l));
+    nlohmann::json traversal = nlohmann::json::array();
+    for (const dof::MultilayerTraversalStats& t : st.traversal) {
         auto finite = [](float z) {
             return std::isfinite(z) ? nlohmann::json(z) : nlohmann::json(nullptr);
         };
-        levels.push_back({{"level", l.index},
-                          {"kind", kindName(l.kind)},
-                          {"width", l.width},
-                          {"height", l.height},
-                          {"dilation", l.dilation},
-                          {"fragments", l.fragments},
-                          {"max_list_length", l.max_list_length},
-                          {"mean_list_length", l.mean_list_length},
-                          {"truncated", l.truncated},
-                          {"radius_px", l.radius_px},
-                          {"z_near", finite(l.z_near)},
-                          {"z_far", finite(l.z_far)}});
+        traversal.push_back({{"level", t.index},
+                             {"kind", kindName(t.kind)},
+                             {"reads", t.level},
+                             {"radius_px", t.radius_px},
+                             {"z_near", finite(t.z_near)},
+                             {"z_far", finite(t.z_far)}});
     }
     out.counts = {{"fragments_collected", st.fragments_collected},
                   {"fragments_rejected_early", st.fragments_rejected},
@@ -141,7 +191,10 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
                   {"slices_blended", st.slices_blended},
                   {"ms_raster", raster_stats.ms_raster},
                   {"ms_resolve", raster_stats.ms_resolve},
-                  {"levels", levels}};
+                  {"asymmetric_aperture", st.asymmetric_aperture},
+                  {"levels", levels},
+                  {"aperture_levels", apertures},
+                  {"traversal", traversal}};
     return {};
 }
 
@@ -161,7 +214,7 @@ MethodEntry makeMultilayerMethod() {
         render
             .add_option("--mip-levels", args->settings.mip_levels,
                         "multilayer: mip-mapping steps before the filter stack (§5.2 Y-map)")
-            ->default_val(2);
+            ->default_val(1);
         render
             .add_option("--stack-levels", args->stack_levels,
                         "multilayer: stack filtering steps, or 'auto' (enough levels for the "
@@ -181,6 +234,32 @@ MethodEntry makeMultilayerMethod() {
                         "multilayer: front-to-back blending of the traversed slices (§6.1, §7)")
             ->check(CLI::IsMember({"over", "additive"}))
             ->default_val("additive");
+        render
+            .add_option("--additive-gap", args->additive_gap,
+                        "multilayer: additive blending within groups of slices whose depths are "
+                        "within a factor 1+G of the previous one, the over operator between "
+                        "groups ('inf': the paper's one group)")
+            ->default_val("1");
+        render
+            .add_option("--merge-depth", args->merge_depth,
+                        "multilayer: the depth of a merged fragment: mean (weighted by opacity) "
+                        "or nearest (the paper's, §5.1)")
+            ->check(CLI::IsMember({"mean", "nearest"}))
+            ->default_val("mean");
+        render
+            .add_option("--level-filter", args->filter,
+                        "multilayer: the blur the traversed levels stand for: aperture (levels "
+                        "shaped like the lens aperture, --aperture-shape) or box (the paper's "
+                        "2^S boxes)")
+            ->check(CLI::IsMember({"aperture", "box"}))
+            ->default_val("aperture");
+        render
+            .add_option("--aperture-grids", args->settings.aperture_grids,
+                        "multilayer: taps per axis of the aperture levels built from each box "
+                        "level (increasing, each below twice the first; one level per grid and "
+                        "octave of blur)")
+            ->delimiter(',')
+            ->default_str("4,5,6");
         render.add_option("--multilayer-levels-out", args->levels_out,
                           "multilayer: write each level's contribution (Fig. 7) to "
                           "PREFIXlevelS.png and PREFIXbackground.png");

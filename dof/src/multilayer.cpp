@@ -1,5 +1,7 @@
 #include <dof/multilayer.h>
 
+#include <raster/check.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -44,31 +46,101 @@ struct Cursor {
 
 constexpr float kOpaque = 1.0f - 1.0f / 1024.0f; // stop once the pixel is this opaque
 
+// The frame's plan: the box hierarchy (§5), the aperture levels read from it, and T, the
+// levels the traversal reads in order of their variance (§6.1).
 struct Plan {
     LevelPlan plan;
-    std::vector<FragmentLevel> geometry;
+    std::vector<FragmentLevel> boxes;     // geometry of box levels 0..n
+    std::vector<FragmentLevel> apertures; // geometry of the aperture levels, in T order
+    struct Entry {
+        bool aperture = false;
+        uint32_t level = 0; // into boxes or apertures
+    };
+    std::vector<Entry> traversal; // T
+    std::vector<double> variance; // V_S of T
+    double radius(size_t s, double m2) const { return std::sqrt(variance[s] / m2); }
 };
 
+// T over the boxes: the boxes themselves, or box 0 and then the aperture levels of box 0, 1, ...
+// (two per box: G = grid and G = grid_mid), each kept only if it blurs more than the previous
+// one, up to the first whose radius reaches the largest |C| of the frame.
+void planTraversal(Plan& p, uint32_t width, uint32_t height, const MultilayerSettings& settings,
+                   const std::vector<ApertureGrid>& grids, double m2, float max_coc_px) {
+    p.apertures.clear();
+    p.traversal.clear();
+    p.variance.clear();
+    if (settings.filter == LevelFilter::Box) {
+        for (uint32_t s = 0; s < p.boxes.size(); ++s) {
+            p.traversal.push_back({false, s});
+            p.variance.push_back(p.boxes[s].variance());
+        }
+        return;
+    }
+    p.traversal.push_back({false, 0});
+    p.variance.push_back(p.boxes[0].variance());
+    for (const FragmentLevel& box : p.boxes)
+        for (const ApertureGrid& grid : grids) {
+            if (p.radius(p.variance.size() - 1, m2) >= double(max_coc_px))
+                return;
+            FragmentLevel a =
+                planApertureLevel(box, grid, uint32_t(p.traversal.size()), width, height);
+            if (!(a.variance() > p.variance.back()))
+                continue;
+            p.traversal.push_back({true, uint32_t(p.apertures.size())});
+            p.variance.push_back(a.variance());
+            p.apertures.push_back(std::move(a));
+        }
+}
+
 Plan makePlan(uint32_t width, uint32_t height, const MultilayerSettings& settings,
-              float max_coc_px) {
+              const std::vector<ApertureGrid>& grids, double m2, float max_coc_px) {
     Plan p;
     p.plan.mip_steps = settings.mip_levels;
     p.plan.epsilon = settings.epsilon;
     p.plan.truncate = settings.truncate;
+    p.plan.mean_depth = settings.mean_depth;
     if (settings.stack_levels >= 0) {
         p.plan.stack_steps = uint32_t(settings.stack_levels);
-        p.geometry = planLevels(width, height, p.plan);
+        p.boxes = planLevels(width, height, p.plan);
+        planTraversal(p, width, height, settings, grids, m2, max_coc_px);
         return p;
     }
-    // Auto: the fewest stack steps whose top level matches the largest |C| in the frame.
+    // Auto: the fewest stack steps whose top level of T matches the largest |C| in the frame.
     for (uint32_t stack = 0;; ++stack) {
         p.plan.stack_steps = stack;
-        p.geometry = planLevels(width, height, p.plan);
-        const double r_top =
-            std::sqrt(p.geometry.back().variance() / settings.aperture_second_moment);
-        if (r_top >= double(max_coc_px) || p.plan.levels() >= kMaxFilterLevels)
+        p.boxes = planLevels(width, height, p.plan);
+        planTraversal(p, width, height, settings, grids, m2, max_coc_px);
+        if (p.radius(p.variance.size() - 1, m2) >= double(max_coc_px) ||
+            p.plan.levels() >= kMaxFilterLevels)
             return p;
     }
+}
+
+// The first level of T that reads box `box` or a box above it (T.size() if none does): box
+// levels are truncated by its lower border (§6.2), since T's borders nest outwards.
+uint32_t firstReader(const Plan& p, uint32_t box) {
+    for (uint32_t s = 0; s < p.traversal.size(); ++s) {
+        const Plan::Entry& e = p.traversal[s];
+        if ((e.aperture ? p.apertures[e.level].source : e.level) >= box)
+            return s;
+    }
+    return uint32_t(p.traversal.size());
+}
+
+MultilayerLevelStats levelStats(const FragmentLevel& l) {
+    MultilayerLevelStats ls;
+    ls.index = l.index;
+    ls.kind = l.kind;
+    ls.width = l.width;
+    ls.height = l.height;
+    ls.dilation = l.dilation;
+    ls.source = l.source;
+    ls.grid = l.grid;
+    ls.fragments = l.fragments;
+    ls.max_list_length = l.max_list_length;
+    ls.mean_list_length = double(l.fragments) / (double(l.width) * double(l.height));
+    ls.truncated = l.truncated;
+    return ls;
 }
 
 } // namespace
@@ -86,6 +158,9 @@ raster::Status validate(const MultilayerSettings& s) {
         return Status::error("--mip-levels + --stack-levels must be at most " +
                              std::to_string(kMaxFilterLevels) + ", got " +
                              std::to_string(s.mip_levels) + " + " + std::to_string(stack));
+    if (std::isnan(s.additive_gap) || s.additive_gap < 0.0f)
+        return Status::error("--additive-gap must be a relative depth gap >= 0 (or inf), got " +
+                             std::to_string(s.additive_gap));
     if (!std::isfinite(s.epsilon) || s.epsilon < 0.0f || s.epsilon > 10.0f)
         return Status::error("--epsilon must be a relative depth threshold in [0, 10], got " +
                              std::to_string(s.epsilon));
@@ -93,6 +168,17 @@ raster::Status validate(const MultilayerSettings& s) {
         return Status::error("the aperture's second moment must be positive and finite");
     if (s.node_capacity == 0)
         return Status::error("the fragment node capacity must be at least 1");
+    if (s.filter == LevelFilter::Aperture) {
+        const std::vector<uint32_t>& g = s.aperture_grids;
+        bool good = !g.empty() && g.size() <= kMaxApertureGrid;
+        for (size_t i = 0; good && i < g.size(); ++i)
+            good = g[i] >= 2 && g[i] <= kMaxApertureGrid && g[i] < 2 * g[0] &&
+                   (i == 0 || g[i] > g[i - 1]);
+        if (!good)
+            return Status::error("--aperture-grids must be increasing taps per axis in [2, " +
+                                 std::to_string(kMaxApertureGrid) +
+                                 "], each below twice the first (e.g. 4,5,6)");
+    }
     return {};
 }
 
@@ -159,18 +245,36 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                                 std::fabs(cocRadiusPx(lens, row_max[y]))});
     const double ms_base = msSince(t0);
 
-    // §5: plan the Y-map, compute the border table T (§6.1), filter level by level.
+    // The aperture drawn on the tap grids, for both sides of the focal plane.
+    const bool shaped = settings.filter == LevelFilter::Aperture;
+    std::vector<ApertureGrid> grids[2]; // [far, near], one per settings.aperture_grids
+    double m2 = settings.aperture_second_moment;
+    bool asymmetric = false;
+    if (shaped) {
+        for (uint32_t size : settings.aperture_grids)
+            for (FocalSide side : {FocalSide::Far, FocalSide::Near}) {
+                raster::Result<ApertureGrid> r = apertureGrid(settings.aperture, size, side);
+                if (!r.ok())
+                    return raster::Status::error("multilayer: " + r.status().message());
+                grids[side == FocalSide::Far ? 0 : 1].push_back(std::move(*r));
+            }
+        m2 = grids[0][0].second_moment;
+        for (size_t g = 0; g < grids[0].size(); ++g)
+            asymmetric = asymmetric || !sameWeights(grids[0][g], grids[1][g]);
+    }
+
+    // §5: plan the Y-map and T, compute the border table (§6.1), filter level by level.
     t0 = std::chrono::steady_clock::now();
-    Plan plan = makePlan(width, height, settings, max_coc);
-    const uint32_t n = plan.plan.levels();
-    std::vector<double> variance;
-    for (const FragmentLevel& g : plan.geometry)
-        variance.push_back(g.variance());
-    borders_ = levelBorders(lens, variance, settings.aperture_second_moment);
-    levels_.resize(n + 1);
-    for (uint32_t s = 1; s <= n; ++s) {
+    Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
+    borders_ = levelBorders(lens, plan.variance, m2);
+    const uint32_t boxes_needed = std::min(
+        uint32_t(plan.boxes.size()),
+        shaped ? plan.apertures.empty() ? 1u : plan.apertures.back().source + 1u
+               : uint32_t(plan.boxes.size()));
+    levels_.resize(boxes_needed);
+    for (uint32_t s = 1; s < boxes_needed; ++s) {
         FragmentLevel& l = levels_[s];
-        const FragmentLevel& g = plan.geometry[s];
+        const FragmentLevel& g = plan.boxes[s];
         l.index = g.index;
         l.kind = g.kind;
         l.width = g.width;
@@ -181,15 +285,53 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         l.dilation = g.dilation;
         l.filter_variance = g.filter_variance;
         l.lookup_variance = g.lookup_variance;
-        filterLevel(levels_[s - 1], plan.plan, borders_, pool, l);
+        filterLevel(levels_[s - 1], plan.plan, borders_, firstReader(plan, s), pool, l);
     }
+    // Aperture levels, far side then (asymmetric aperture) near side; rows of each level
+    // reuse their memory between frames.
+    const size_t shaped_count = plan.apertures.size();
+    apertures_.resize(asymmetric ? 2 * shaped_count : shaped_count);
+    for (size_t side = 0; side < (asymmetric ? 2u : 1u); ++side)
+        for (size_t a = 0; a < shaped_count; ++a) {
+            FragmentLevel& l = apertures_[side * shaped_count + a];
+            std::vector<std::vector<LayerFragment>> rows = std::move(l.rows);
+            l = plan.apertures[a];
+            l.rows = std::move(rows);
+            const auto grid = std::find_if(grids[side].begin(), grids[side].end(),
+                                           [&](const ApertureGrid& g) { return g.size == l.grid; });
+            shapeLevel(levels_[l.source], *grid, plan.plan, borders_, pool, l);
+        }
     const double ms_filter = msSince(t0);
+
+    // The levels of T on each side of the focal plane ([near, far]).
+    const uint32_t n = uint32_t(plan.traversal.size()) - 1;
+    constexpr uint32_t kMaxT = 2 * (kMaxFilterLevels + 1) + 1;
+    FOCAL_CHECK(n + 1 <= kMaxT);
+    const FragmentLevel* tlevel[2][kMaxT] = {};
+    for (uint32_t s = 0; s <= n; ++s) {
+        const Plan::Entry& e = plan.traversal[s];
+        tlevel[1][s] = e.aperture ? &apertures_[e.level] : &levels_[e.level];
+        tlevel[0][s] = e.aperture && asymmetric ? &apertures_[shaped_count + e.level]
+                                                : tlevel[1][s];
+    }
+    // T as segments; with an asymmetric aperture the one across the focal plane is split there,
+    // so that every slice reads the levels of its own side.
+    std::vector<LevelBorders::Segment> segments;
+    for (const LevelBorders::Segment& seg : borders_.segments) {
+        if (asymmetric && seg.begin < lens.focus_distance && seg.end > lens.focus_distance) {
+            segments.push_back({seg.begin, lens.focus_distance, seg.lo, seg.hi});
+            segments.push_back({lens.focus_distance, seg.end, seg.lo, seg.hi});
+        } else {
+            segments.push_back(seg);
+        }
+    }
+    const uint32_t sides = asymmetric ? 2 : 1;
 
     // §6.1: traverse T near to far per pixel, blend the slices met front to back.
     t0 = std::chrono::steady_clock::now();
     std::vector<std::vector<AxisTap>> tx(n + 1), ty(n + 1);
     for (uint32_t s = 0; s <= n; ++s) {
-        const FragmentLevel& l = levels_[s];
+        const FragmentLevel& l = *tlevel[1][s];
         tx[s] = axisTaps(width, l.origin_x, l.spacing, l.width);
         ty[s] = axisTaps(height, l.origin_y, l.spacing, l.height);
     }
@@ -202,47 +344,55 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     if (contributions)
         out.level_rgba.assign(n + 2, std::vector<float>(size_t(width) * height * 4, 0.0f));
     const float scale = 1.0f + settings.epsilon;
-    const bool additive = settings.blend == LayerBlend::Additive;
+    // Slices join the group of the previous one while within this factor of its depth.
+    const float group_scale =
+        settings.blend == LayerBlend::Additive ? 1.0f + settings.additive_gap : 0.0f;
     std::vector<uint64_t> row_slices(height, 0);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
-        Cursor cursors[kMaxFilterLevels + 1][4];
-        uint32_t cursor_count[kMaxFilterLevels + 1];
+        Cursor cursors[2][kMaxT][4];
+        uint32_t cursor_count[2][kMaxT];
         for (uint32_t x = 0; x < width; ++x) {
             const size_t p = size_t(y) * width + x;
             // Bilinear taps of every level at the pixel centre (zero weights skipped).
-            for (uint32_t s = 0; s <= n; ++s) {
-                const AxisTap ax = tx[s][x];
-                const AxisTap ay = ty[s][y];
-                const uint32_t cx[4] = {ax.i0, ax.i1, ax.i0, ax.i1};
-                const uint32_t cy[4] = {ay.i0, ay.i0, ay.i1, ay.i1};
-                const float w[4] = {(1.0f - ax.f) * (1.0f - ay.f), ax.f * (1.0f - ay.f),
-                                    (1.0f - ax.f) * ay.f, ax.f * ay.f};
-                uint32_t c = 0;
-                for (int k = 0; k < 4; ++k) {
-                    if (!(w[k] > 0.0f))
-                        continue;
-                    Cursor& cur = cursors[s][c++];
-                    cur.data = levels_[s].list(cx[k], cy[k], cur.count);
-                    cur.next = 0;
-                    cur.weight = w[k];
+            for (uint32_t side = 0; side < sides; ++side)
+                for (uint32_t s = 0; s <= n; ++s) {
+                    const AxisTap ax = tx[s][x];
+                    const AxisTap ay = ty[s][y];
+                    const uint32_t cx[4] = {ax.i0, ax.i1, ax.i0, ax.i1};
+                    const uint32_t cy[4] = {ay.i0, ay.i0, ay.i1, ay.i1};
+                    const float w[4] = {(1.0f - ax.f) * (1.0f - ay.f), ax.f * (1.0f - ay.f),
+                                        (1.0f - ax.f) * ay.f, ax.f * ay.f};
+                    uint32_t c = 0;
+                    for (int k = 0; k < 4; ++k) {
+                        if (!(w[k] > 0.0f))
+                            continue;
+                        Cursor& cur = cursors[side][s][c++];
+                        cur.data = tlevel[side][s]->list(cx[k], cy[k], cur.count);
+                        cur.next = 0;
+                        cur.weight = w[k];
+                    }
+                    cursor_count[side][s] = c;
                 }
-                cursor_count[s] = c;
-            }
             {
-                const Cursor& b = cursors[0][0];
+                const Cursor& b = cursors[0][0][0];
                 if (b.count > 0)
                     out.depth[p] = b.data[0].depth;
             }
             float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
-            for (const LevelBorders::Segment& seg : borders_.segments) {
+            float ca_g = 0.0f, ga = 0.0f, last_d = 0.0f;
+            bool first = true;
+            for (const LevelBorders::Segment& seg : segments) {
                 if (ca >= kOpaque)
                     break;
+                const uint32_t side = sides == 2 && seg.begin >= lens.focus_distance ? 1 : 0;
+                Cursor(&cur_side)[kMaxT][4] = cursors[side];
+                const uint32_t* count_side = cursor_count[side];
                 const uint32_t lv[2] = {seg.lo, seg.hi};
                 const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
                 // Skip what lies in front of the segment (not asked of this level there).
                 for (uint32_t c = 0; c < classes; ++c)
-                    for (uint32_t k = 0; k < cursor_count[lv[c]]; ++k) {
-                        Cursor& cur = cursors[lv[c]][k];
+                    for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
+                        Cursor& cur = cur_side[lv[c]][k];
                         while (cur.next < cur.count && cur.data[cur.next].depth < seg.begin)
                             ++cur.next;
                     }
@@ -251,8 +401,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                     float d0 = seg.end;
                     bool any = false;
                     for (uint32_t c = 0; c < classes; ++c)
-                        for (uint32_t k = 0; k < cursor_count[lv[c]]; ++k) {
-                            const Cursor& cur = cursors[lv[c]][k];
+                        for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
+                            const Cursor& cur = cur_side[lv[c]][k];
                             if (cur.next < cur.count && cur.data[cur.next].depth < d0)
                                 d0 = cur.data[cur.next].depth, any = true;
                         }
@@ -265,8 +415,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                     float part[2][4] = {{0.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
                     for (uint32_t c = 0; c < classes; ++c) {
                         const float level_weight = classes == 1 ? 1.0f : (c == 0 ? 1.0f - t : t);
-                        for (uint32_t k = 0; k < cursor_count[lv[c]]; ++k) {
-                            Cursor& cur = cursors[lv[c]][k];
+                        for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
+                            Cursor& cur = cur_side[lv[c]][k];
                             float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
                             for (; cur.next < cur.count && cur.data[cur.next].depth <= limit;
                                  ++cur.next) {
@@ -283,14 +433,23 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                     if (!(sa > 0.0f))
                         continue;
                     ++row_slices[y];
-                    // Front-to-back blending of the slice (§6.1).
-                    float k = 1.0f - ca;
-                    if (additive)
-                        k = std::min(sa, 1.0f - ca) / sa;
+                    // Front-to-back blending of the slice (§6.1): additive within a group of
+                    // slices (disjoint pieces of one layer, §7), the over operator between
+                    // groups (layers at clearly different depths, whose holes the lens sees
+                    // independently).
+                    if (first || !(d0 <= last_d * group_scale)) {
+                        ca_g = ca;
+                        ga = 0.0f;
+                    }
+                    first = false;
+                    last_d = d0;
+                    const float take = std::min(sa, 1.0f - ga);
+                    const float k = (1.0f - ca_g) * take / sa;
+                    ga += take;
                     cr += k * (part[0][0] + part[1][0]);
                     cg += k * (part[0][1] + part[1][1]);
                     cb += k * (part[0][2] + part[1][2]);
-                    ca += k * sa;
+                    ca = ca_g + (1.0f - ca_g) * ga;
                     if (contributions)
                         for (uint32_t c = 0; c < classes; ++c) {
                             float* o = out.level_rgba[lv[c]].data() + 4 * p;
@@ -329,24 +488,23 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         st.mip_levels = plan.plan.mip_steps;
         st.stack_levels = plan.plan.stack_steps;
         st.max_coc_px = max_coc;
+        st.second_moment = m2;
+        st.asymmetric_aperture = asymmetric;
         for (uint64_t c : row_slices)
             st.slices_blended += c;
+        for (const FragmentLevel& l : levels_)
+            st.levels.push_back(levelStats(l));
+        for (size_t a = 0; a < shaped_count; ++a)
+            st.apertures.push_back(levelStats(apertures_[a]));
         for (uint32_t s = 0; s <= n; ++s) {
-            const FragmentLevel& l = levels_[s];
-            MultilayerLevelStats ls;
-            ls.index = s;
-            ls.kind = l.kind;
-            ls.width = l.width;
-            ls.height = l.height;
-            ls.dilation = l.dilation;
-            ls.fragments = l.fragments;
-            ls.max_list_length = l.max_list_length;
-            ls.mean_list_length = double(l.fragments) / (double(l.width) * double(l.height));
-            ls.truncated = l.truncated;
-            ls.radius_px = borders_.radius[s];
-            ls.z_near = borders_.z_near[s];
-            ls.z_far = borders_.z_far[s];
-            st.levels.push_back(ls);
+            MultilayerTraversalStats ts;
+            ts.index = s;
+            ts.kind = tlevel[1][s]->kind;
+            ts.level = plan.traversal[s].level;
+            ts.radius_px = borders_.radius[s];
+            ts.z_near = borders_.z_near[s];
+            ts.z_far = borders_.z_far[s];
+            st.traversal.push_back(ts);
         }
     }
     return {};

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <raster/check.h>
+
 namespace dof {
 namespace {
 
@@ -19,6 +21,19 @@ double lookupVariance(double origin, double spacing, uint32_t extent) {
         sum += f * (1.0 - f);
     }
     return spacing * spacing * sum / double(period);
+}
+
+// A level's totals from its rows' counts.
+void sumRows(const std::vector<uint32_t>& longest, const std::vector<uint64_t>& dropped,
+             FragmentLevel& level) {
+    level.fragments = 0;
+    level.max_list_length = 0;
+    level.truncated = 0;
+    for (uint32_t j = 0; j < level.height; ++j) {
+        level.fragments += level.rows[j].size();
+        level.max_list_length = std::max(level.max_list_length, longest[j]);
+        level.truncated += dropped[j];
+    }
 }
 
 void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_height) {
@@ -157,17 +172,11 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
         }
         starts[lists.width] = uint32_t(row.size());
     });
-    out.fragments = 0;
-    out.max_list_length = 0;
-    out.truncated = 0;
-    for (uint32_t y = 0; y < lists.height; ++y) {
-        out.fragments += out.rows[y].size();
-        out.max_list_length = std::max(out.max_list_length, longest[y]);
-    }
+    sumRows(longest, std::vector<uint64_t>(lists.height, 0), out);
 }
 
 void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBorders& borders,
-                 raster::TaskPool& pool, FragmentLevel& next) {
+                 uint32_t border_level, raster::TaskPool& pool, FragmentLevel& next) {
     next.rows.resize(next.height);
     next.starts.assign(size_t(next.height) * (next.width + 1), 0);
     std::vector<uint32_t> longest(next.height, 0);
@@ -176,7 +185,6 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
     const int32_t delta = int32_t(next.dilation);
     const int32_t max_x = int32_t(prev.width) - 1;
     const int32_t max_y = int32_t(prev.height) - 1;
-    const uint32_t level = next.index;
     pool.parallelFor(next.height, [&](uint32_t j, uint32_t) {
         std::vector<LayerFragment>& row = next.rows[j];
         row.clear();
@@ -184,7 +192,9 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
         // Source rows and columns: mip 2j, 2j+1; stack j-Δ, j (border cells clamped, Fig. 4).
         const int32_t y0 = std::clamp(mip ? 2 * int32_t(j) : int32_t(j) - delta, 0, max_y);
         const int32_t y1 = std::clamp(mip ? 2 * int32_t(j) + 1 : int32_t(j), 0, max_y);
-        auto keep = [&](float d) { return !plan.truncate || !truncatedAt(borders, level, d); };
+        auto keep = [&](float d) {
+            return !plan.truncate || !truncatedAt(borders, border_level, d);
+        };
         for (uint32_t i = 0; i < next.width; ++i) {
             const int32_t x0 = std::clamp(mip ? 2 * int32_t(i) : int32_t(i) - delta, 0, max_x);
             const int32_t x1 = std::clamp(mip ? 2 * int32_t(i) + 1 : int32_t(i), 0, max_x);
@@ -196,19 +206,92 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
                 src[k].weight = 0.25f; // §5.1: α_merged = (α'_1 + ... + α'_4) / 4
             }
             starts[i] = uint32_t(row.size());
-            mergeLists(src, 4, plan.epsilon, keep, row, dropped[j]);
+            mergeLists(src, 4, plan.epsilon, plan.mean_depth, keep, row, dropped[j]);
             longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
         }
         starts[next.width] = uint32_t(row.size());
     });
-    next.fragments = 0;
-    next.max_list_length = 0;
-    next.truncated = 0;
-    for (uint32_t j = 0; j < next.height; ++j) {
-        next.fragments += next.rows[j].size();
-        next.max_list_length = std::max(next.max_list_length, longest[j]);
-        next.truncated += dropped[j];
-    }
+    sumRows(longest, dropped, next);
+}
+
+FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& grid,
+                                uint32_t index, uint32_t base_width, uint32_t base_height) {
+    FragmentLevel level;
+    level.index = index;
+    level.kind = LevelKind::Aperture;
+    level.source = box.index;
+    level.grid = grid.size;
+    const double tap_px = std::ldexp(1.0, int(box.index)); // the source's box: 2^L base pixels
+    level.dilation = std::max(1u, uint32_t(tap_px / double(box.spacing)));
+    const uint32_t reach = (grid.size - 1) * level.dilation; // cells from the first tap to the last
+    level.width = box.width + reach;
+    level.height = box.height + reach;
+    level.spacing = box.spacing;
+    // Cell i reads box cells i - reach + a·dilation (a = 0..G-1): its centre is their mean.
+    const float shift = 0.5f * float(reach) * box.spacing;
+    level.origin_x = box.origin_x - shift;
+    level.origin_y = box.origin_y - shift;
+    // Second moment of the taps about the centre, (a - (G-1)/2)·2^L per axis, plus the box
+    // each tap reads (its 2^L point samples, as finishGeometry).
+    const double mid = 0.5 * double(grid.size - 1);
+    double mx = 0.0, my = 0.0;
+    for (uint32_t b = 0; b < grid.size; ++b)
+        for (uint32_t a = 0; a < grid.size; ++a) {
+            const double w = double(grid.at(a, b));
+            mx += w * (double(a) - mid) * (double(a) - mid);
+            my += w * (double(b) - mid) * (double(b) - mid);
+        }
+    level.filter_variance = 0.5 * (mx + my) * tap_px * tap_px + (tap_px * tap_px - 1.0) / 12.0;
+    level.lookup_variance = 0.5 * (lookupVariance(level.origin_x, level.spacing, base_width) +
+                                   lookupVariance(level.origin_y, level.spacing, base_height));
+    return level;
+}
+
+void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelPlan& plan,
+                const LevelBorders& borders, raster::TaskPool& pool, FragmentLevel& out) {
+    FOCAL_CHECK(grid.size >= 1 && grid.size <= kMaxApertureGrid);
+    out.rows.resize(out.height);
+    out.starts.assign(size_t(out.height) * (out.width + 1), 0);
+    std::vector<uint32_t> longest(out.height, 0);
+    std::vector<uint64_t> dropped(out.height, 0);
+    const int32_t step = int32_t(out.dilation);
+    const int32_t reach = int32_t(grid.size - 1) * step;
+    const int32_t max_x = int32_t(box.width) - 1;
+    const int32_t max_y = int32_t(box.height) - 1;
+    // The taps with weight, in grid order (a fixed merge order).
+    struct Tap {
+        int32_t a = 0;
+        int32_t b = 0;
+        float weight = 0.0f;
+    };
+    std::vector<Tap> taps;
+    for (uint32_t b = 0; b < grid.size; ++b)
+        for (uint32_t a = 0; a < grid.size; ++a)
+            if (grid.at(a, b) > 0.0f)
+                taps.push_back({int32_t(a) * step - reach, int32_t(b) * step - reach, grid.at(a, b)});
+    const uint32_t level = out.index;
+    pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
+        std::vector<LayerFragment>& row = out.rows[j];
+        row.clear();
+        uint32_t* starts = out.starts.data() + size_t(j) * (out.width + 1);
+        auto keep = [&](float d) { return !plan.truncate || !truncatedAt(borders, level, d); };
+        ListRef src[kMaxMergeLists];
+        for (uint32_t i = 0; i < out.width; ++i) {
+            for (size_t k = 0; k < taps.size(); ++k) {
+                // Border cells clamped, as the stack's (Fig. 4).
+                const int32_t x = std::clamp(int32_t(i) + taps[k].a, 0, max_x);
+                const int32_t y = std::clamp(int32_t(j) + taps[k].b, 0, max_y);
+                src[k].data = box.list(uint32_t(x), uint32_t(y), src[k].count);
+                src[k].weight = taps[k].weight;
+            }
+            starts[i] = uint32_t(row.size());
+            mergeLists(src, uint32_t(taps.size()), plan.epsilon, plan.mean_depth, keep, row,
+                       dropped[j]);
+            longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
+        }
+        starts[out.width] = uint32_t(row.size());
+    });
+    sumRows(longest, dropped, out);
 }
 
 } // namespace dof

@@ -215,6 +215,10 @@ INSTANTIATE_TEST_SUITE_P(
         UsageCase{"thickness_zero", renderArgs({"--method", "multiview", "--thickness", "0"})},
         UsageCase{"bound_init_unknown",
                   renderArgs({"--method", "multiview", "--bound-init", "yes"})},
+        UsageCase{"level_filter_unknown",
+                  renderArgs({"--method", "multilayer", "--level-filter", "disc"})},
+        UsageCase{"aperture_grids_not_numbers",
+                  renderArgs({"--method", "multilayer", "--aperture-grids", "four"})},
         UsageCase{"info_without_scene", {"info"}}),
     usageCaseName);
 

@@ -1,8 +1,10 @@
 // The filtered multi-layer hierarchy of Selgrad et al. 2015 §5: fragment lists of level 0 (the
 // collected base, §4) filtered into levels 1..n by 2x2 mip steps (§5.1) and then 2x2 stack steps
 // (§5.2, the Y-map), each step a merge-sort-like combine that merges fragments of similar depth.
-// Also the per-frame level border table T (§6.1) and the truncation rule (§6.2) that both follow
-// from the thin lens. Consumes raster::FragmentLists and a ThinLens; produces FragmentLevels that
+// Aperture-shaped levels read a box level through a grid of taps weighted by the aperture
+// (dof/aperture_grid.h), so that the blur they stand for has the lens's shape (the paper's §5.2
+// names other filters as possible; §8 suggests per-level post-processing). Also the per-frame
+// level border table T (§6.1) and the truncation rule (§6.2) that both follow from the thin lens. Consumes raster::FragmentLists and a ThinLens; produces FragmentLevels that
 // the caller owns (FragmentHierarchy keeps their memory between frames).
 //
 // Fragments are stored premultiplied: (α·c, α, d). The paper's merged colour c' is stored as α'c',
@@ -10,12 +12,14 @@
 // Depth d is the distance along the view axis (raster::distanceFromDepth), float32.
 #pragma once
 
+#include <dof/aperture_grid.h>
 #include <dof/lens.h>
 #include <raster/camera.h>
 #include <raster/fragment_lists.h>
 #include <raster/status.h>
 #include <raster/task_pool.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -34,6 +38,8 @@ enum class LevelKind : uint8_t {
     Base,  // level 0: the collected lists (§4)
     Mip,   // 2x2 lists of the level below merged into one, half the resolution (§5.1)
     Stack, // 2x2 box without downsampling: the image grows by the dilation per level (§5.2)
+    Aperture, // G x G taps of a box level, 2^source base pixels apart, weighted by the aperture
+              // (dof/aperture_grid.h): a disc (or polygon, or image) of diameter G·2^source
 };
 
 // One level of the hierarchy: width x height cells, each a depth-sorted fragment list. Cells are
@@ -51,9 +57,13 @@ struct FragmentLevel {
     float spacing = 1.0f;  // base pixels between neighbouring cell centres (2^mip steps)
     float origin_x = 0.5f; // base-pixel coordinate of cell (0, 0)'s centre
     float origin_y = 0.5f;
-    uint32_t dilation = 0; // Stack: cells between the two taps combined per axis; Mip: 1
+    uint32_t dilation = 0; // Stack: cells between the two taps combined per axis; Mip: 1;
+                           // Aperture: cells between neighbouring taps
+    uint32_t source = 0;   // Aperture: the box level its taps read
+    uint32_t grid = 0;     // Aperture: G, taps per axis
     // Variance per axis, in base pixels², of the level's filter: the box of 2^S point samples,
-    // (4^S - 1)/12, plus the mean variance the bilinear lookup at pixel centres adds.
+    // (4^S - 1)/12 (Aperture: the taps' second moment about the centre plus the variance of
+    // the source's box), plus the mean variance the bilinear lookup at pixel centres adds.
     double filter_variance = 0.0;
     double lookup_variance = 0.0;
 
@@ -80,10 +90,17 @@ struct LevelPlan {
     uint32_t stack_steps = 2;
     float epsilon = 0.2f; // §5.1 depth threshold, relative: merge while d <= d0·(1 + ε)
     bool truncate = true; // §6.2: drop the depth intervals a level is never asked for
+    // The depth a merged fragment carries: the mean of what it merged, weighted by visible
+    // opacity (true), or the paper's, the closest one's d0 (false). The mean keeps a level's
+    // copy of a slanted surface at the surface's depth at the cell centre, so every level puts
+    // it in the same segment of T.
+    bool mean_depth = true;
     uint32_t levels() const { return mip_steps + stack_steps; }
 };
 
 constexpr uint32_t kMaxFilterLevels = 12;
+constexpr uint32_t kMaxApertureGrid = 8; // taps per axis of an aperture-shaped level
+constexpr uint32_t kMaxMergeLists = kMaxApertureGrid * kMaxApertureGrid;
 
 // The level border table T of §6.1, computed per frame. The paper matches Coc(z) = F|z - z_f|
 // with the level's filter size fs_S(z) = 2^S G z; in pixels that is |C(d)| = r_S with r_S
@@ -121,18 +138,20 @@ LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level
 float levelBlend(const LevelBorders& borders, const ThinLens& lens,
                  const LevelBorders::Segment& segment, float depth);
 
-// §6.2: true when level `level` (>= 1) is never asked for depth d, and no level above it needs
-// it either: z_{N,S-1} < d < z_{F,S-1}, the middle interval (which also covers the far field
-// past the plateau, Fig. 8).
+// §6.2: true when level `level` (>= 1) of T is never asked for depth d, and no level above it
+// needs it either: z_{N,S-1} < d < z_{F,S-1}, the middle interval (which also covers the far
+// field past the plateau, Fig. 8).
 inline bool truncatedAt(const LevelBorders& borders, uint32_t level, float depth) {
     return level >= 1 && depth > borders.z_near[level - 1] && depth < borders.z_far[level - 1];
 }
 
-// §5.1 merge of up to 8 depth-sorted lists into one sorted list, like merge sort's combine:
-// take the closest fragment d0 of all lists; from every list take its fragments with
+// §5.1 merge of up to kMaxMergeLists depth-sorted lists into one sorted list, like merge
+// sort's combine: take the closest fragment d0 of all lists; from every list take its fragments with
 // d <= d0·(1 + ε) and blend them with the over operator (front to back, within one list); add
 // the lists' results weighted (the paper: 1/4 each for 2x2 lists, empty lists count as α' = 0);
-// emit (Σ w α'c', Σ w α', d0); repeat. Merged fragments with zero opacity are not emitted.
+// emit (Σ w α'c', Σ w α', depth) with depth d0 or, with mean_depth, the mean depth of what was
+// merged weighted by its visible opacity (in [d0, d0·(1 + ε)], so the output stays sorted);
+// repeat. Merged fragments with zero opacity are not emitted.
 // `keep(d0)` may drop a merged fragment (§6.2). Appends to `out`.
 struct ListRef {
     const LayerFragment* data = nullptr;
@@ -140,8 +159,8 @@ struct ListRef {
     float weight = 0.0f;
 };
 template <class Keep>
-void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, Keep&& keep,
-                std::vector<LayerFragment>& out, uint64_t& dropped);
+void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
+                Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped);
 
 // Level 0 from the collected lists: premultiplies colour by opacity and converts stored depth D
 // to view distance. Fragments with zero opacity are dropped.
@@ -154,16 +173,32 @@ std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const Lev
 
 // Fills level `next` (geometry from planLevels) from `prev` (§5.1 mip or §5.2 stack step),
 // one task per row of cells, each cell merged in a fixed order: the bytes do not depend on the
-// thread count. With plan.truncate, merged fragments in next's middle interval are dropped.
+// thread count. With plan.truncate, merged fragments that level `border_level` of T and every
+// level above it never ask for are dropped (truncatedAt).
 void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBorders& borders,
-                 raster::TaskPool& pool, FragmentLevel& next);
+                 uint32_t border_level, raster::TaskPool& pool, FragmentLevel& next);
+
+// The geometry of the aperture-shaped level that reads `box` through `grid`: its taps sit
+// 2^box.index base pixels apart (an integer number of box cells, border cells clamped), so the
+// level covers a G·2^box.index square and keeps box's cell spacing; the image grows by the
+// taps' reach. `index` is the level's place in T.
+FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& grid,
+                                uint32_t index, uint32_t base_width, uint32_t base_height);
+
+// Fills the aperture-shaped level `out` (geometry from planApertureLevel) by the §5.1 merge of
+// its G x G taps, weighted by the grid (disjoint areas: additive across taps), one task per row
+// in a fixed order. With plan.truncate, merged fragments level out.index of T never needs are
+// dropped.
+void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelPlan& plan,
+                const LevelBorders& borders, raster::TaskPool& pool, FragmentLevel& out);
 
 // ---------------------------------------------------------------------------------------------
 
 template <class Keep>
-void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, Keep&& keep,
-                std::vector<LayerFragment>& out, uint64_t& dropped) {
-    uint32_t cursor[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
+                Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped) {
+    uint32_t cursor[kMaxMergeLists];
+    std::fill_n(cursor, list_count, 0u);
     const float scale = 1.0f + epsilon;
     for (;;) {
         // Closest head over all lists (ties: the lower list index, a fixed order).
@@ -179,24 +214,27 @@ void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, Keep&&
             return;
         const float limit = d0 * scale;
         LayerFragment merged;
-        merged.depth = d0;
+        float depth_sum = 0.0f; // Σ w·(visible opacity)·depth, for the mean depth
         for (uint32_t k = 0; k < list_count; ++k) {
             // Over operator within list k, front to back (§5.1, first case).
-            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
+            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
             uint32_t c = cursor[k];
             const LayerFragment* l = lists[k].data;
             for (; c < lists[k].count && l[c].depth <= limit; ++c) {
                 const float t = 1.0f - pa;
                 pr += t * l[c].r, pg += t * l[c].g, pb += t * l[c].b, pa += t * l[c].a;
+                pd += t * l[c].a * l[c].depth;
             }
             cursor[k] = c;
             // Additive blending across lists (§5.1, second case), weighted.
             const float w = lists[k].weight;
             merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
+            depth_sum += w * pd;
         }
         if (!(merged.a > 0.0f))
             continue;
-        if (!keep(d0)) {
+        merged.depth = mean_depth ? std::clamp(depth_sum / merged.a, d0, limit) : d0;
+        if (!keep(merged.depth)) {
             ++dropped;
             continue;
         }

@@ -11,6 +11,7 @@
 
 #include <dof/fragment_levels.h>
 #include <dof/lens.h>
+#include <dof/lens_samples.h>
 #include <raster/camera.h>
 #include <raster/fragment_lists.h>
 #include <raster/status.h>
@@ -30,19 +31,43 @@ namespace dof {
 enum class LayerBlend : uint8_t {
     Over,     // α-blending with the over operator, as for fragments of one list (§5.1)
     Additive, // additive: Σ α_i c_i until the opacities sum to 1 (§7: avoids light leaks at
-              // grazing angles, over-estimates partly transparent middle layers)
+              // grazing angles, over-estimates partly transparent middle layers), within groups
+              // of slices closer in depth than MultilayerSettings::additive_gap; the over
+              // operator between groups
+};
+
+// Which filter the traversed levels stand for.
+enum class LevelFilter : uint8_t {
+    Box,      // the paper's levels themselves: 2^S x 2^S boxes (§2, §5), square bokeh
+    Aperture, // aperture-shaped levels read from the boxes (FragmentLevel, LevelKind::Aperture):
+              // the lens's own blur, so bokeh has the aperture's shape
 };
 
 struct MultilayerSettings {
     uint32_t fragments_per_pixel = 4; // §4: closest N kept per pixel (paper: 3-4; 16); 0 = all
-    uint32_t mip_levels = 2;          // §5.2 Y-map: mip steps before the stack
+    uint32_t mip_levels = 1;          // §5.2 Y-map: mip steps before the stack (Table 3: 1/3)
     int32_t stack_levels = -1;        // stack steps; -1 = auto: until the top level's filter
                                       // matches the largest |C(d)| of the collected fragments
     float epsilon = 0.2f;             // §5.1 depth threshold, relative to the depth
     bool truncate = true;             // §6.2 fragment list truncation
+    bool mean_depth = true; // merged fragments carry their mean depth (LevelPlan::mean_depth);
+                            // false: the closest one's, as the paper
     LayerBlend blend = LayerBlend::Additive; // §7: the paper's general choice
+    // Additive blending: a slice joins the group of the previous one when its depth is within
+    // a factor (1 + additive_gap) of it; groups are combined with the over operator. +inf:
+    // one group, the paper's additive blending; 0: every slice its own group (over).
+    float additive_gap = 1.0f;
+    LevelFilter filter = LevelFilter::Aperture;
+    // Aperture levels: the shape (shared with accum and multiview) and the tap grids built
+    // from each box level L, G x G taps 2^L base pixels apart (a level G·2^L pixels wide).
+    // Increasing, each in [2, kMaxApertureGrid] and below twice the first, so that every
+    // octave of blur gets one level per grid: {4, 5, 6} gives the widths 4, 5, 6, 8, 10, 12,
+    // 16, ... pixels.
+    ApertureShape aperture;
+    std::vector<uint32_t> aperture_grids = {4, 5, 6};
     // Per-axis second moment of the aperture in lens units² (1/4: uniform disk); the level
-    // borders match m2·C(d)² to the level's variance (docs/dof/multilayer.md).
+    // borders match m2·C(d)² to the level's variance (docs/dof/multilayer.md). Box levels
+    // only: aperture levels take it from the aperture grid's samples.
     double aperture_second_moment = 0.25;
     // §4 storage of the collected lists: half colour + opacity, float depth (the paper's).
     raster::ColorFormat color_format = raster::ColorFormat::Half;
@@ -55,19 +80,29 @@ struct MultilayerSettings {
 // Rejects bad settings with a message naming the command-line option.
 raster::Status validate(const MultilayerSettings& settings);
 
+// One level built this frame: a box level of the hierarchy or an aperture level.
 struct MultilayerLevelStats {
     uint32_t index = 0;
     LevelKind kind = LevelKind::Base;
     uint32_t width = 0;
     uint32_t height = 0;
     uint32_t dilation = 0;
+    uint32_t source = 0; // Aperture: the box level read
+    uint32_t grid = 0;   // Aperture: taps per axis
     uint64_t fragments = 0;
     uint32_t max_list_length = 0;
     double mean_list_length = 0.0; // fragments / cells
     uint64_t truncated = 0;        // merged fragments dropped by §6.2
-    double radius_px = 0.0;        // r_S: the |C| this level matches (§6.1)
-    float z_near = 0.0f;           // z_{N,S}
-    float z_far = 0.0f;            // z_{F,S} (+inf past the plateau)
+};
+
+// One level of the border table T (§6.1): the level the traversal reads between its borders.
+struct MultilayerTraversalStats {
+    uint32_t index = 0;    // S in T
+    LevelKind kind = LevelKind::Base;
+    uint32_t level = 0;    // Box: index into MultilayerStats::levels; Aperture: into apertures
+    double radius_px = 0.0; // r_S: the |C| this level matches
+    float z_near = 0.0f;    // z_{N,S}
+    float z_far = 0.0f;     // z_{F,S} (+inf past the plateau)
 };
 
 struct MultilayerStats {
@@ -83,7 +118,12 @@ struct MultilayerStats {
     uint32_t stack_levels = 0;
     float max_coc_px = 0.0f;     // largest |C(d)| over the collected fragments
     uint64_t slices_blended = 0; // merged slices composited during the traversal
-    std::vector<MultilayerLevelStats> levels;
+    double second_moment = 0.0;  // m2 the border table used
+    bool asymmetric_aperture = false; // near and far aperture levels built apart
+    std::vector<MultilayerLevelStats> levels;    // the box hierarchy (§5)
+    std::vector<MultilayerLevelStats> apertures; // aperture levels (far side; the near side
+                                                 // mirrors it when asymmetric_aperture)
+    std::vector<MultilayerTraversalStats> traversal; // T
 };
 
 struct MultilayerImage {
@@ -91,9 +131,9 @@ struct MultilayerImage {
     uint32_t height = 0;
     std::vector<float> rgba;  // linear RGBA (alpha 1), top row first
     std::vector<float> depth; // distance of the closest collected fragment (+inf: background)
-    // With settings.level_contributions: per level S the premultiplied RGB it adds to the
-    // final image (A = its share of the coverage), and the background's share last; they sum
-    // to rgba.
+    // With settings.level_contributions: per level S of T the premultiplied RGB it adds to
+    // the final image (A = its share of the coverage), and the background's share last; they
+    // sum to rgba.
     std::vector<std::vector<float>> level_rgba;
 };
 
@@ -117,14 +157,17 @@ public:
                                    const MultilayerSettings& settings, raster::TaskPool& pool,
                                    MultilayerImage& out, MultilayerStats* stats = nullptr);
 
-    // The last frame's data.
+    // The last frame's data: the box hierarchy, the aperture levels (far side first, then the
+    // near side when the aperture is not symmetric under a half turn), T.
     const raster::FragmentLists& lists() const { return lists_; }
     const std::vector<FragmentLevel>& levels() const { return levels_; }
+    const std::vector<FragmentLevel>& apertureLevels() const { return apertures_; }
     const LevelBorders& borders() const { return borders_; }
 
 private:
     raster::FragmentLists lists_;
     std::vector<FragmentLevel> levels_;
+    std::vector<FragmentLevel> apertures_;
     LevelBorders borders_;
 };
 

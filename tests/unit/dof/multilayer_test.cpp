@@ -3,6 +3,7 @@
 #include "dof_test_util.h"
 
 #include <dof/fragment_levels.h>
+#include <dof/metrics.h>
 #include <dof/multilayer.h>
 #include <raster/fragment_lists.h>
 #include <raster/renderer.h>
@@ -12,6 +13,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace focal::test {
 namespace {
@@ -27,6 +29,7 @@ struct MlRun {
     dof::MultilayerImage image;
     dof::MultilayerStats stats;
     std::vector<dof::FragmentLevel> levels;
+    std::vector<dof::FragmentLevel> apertures;
 };
 
 MlRun runMultilayer(const raster::Scene& scene, const raster::View& view, const dof::ThinLens& lens,
@@ -43,6 +46,7 @@ MlRun runMultilayer(const raster::Scene& scene, const raster::View& view, const 
         ml.render(view, lens, scene.background, settings, collect, pool, run.image, &run.stats);
     EXPECT_TRUE(s.ok()) << s.message();
     run.levels = ml.levels();
+    run.apertures = ml.apertureLevels();
     return run;
 }
 
@@ -90,7 +94,7 @@ TEST(Multilayer, MergeOpaqueStaysOpaqueAndSilhouettesTurnTransparent) {
     std::vector<dof::LayerFragment> out;
     uint64_t dropped = 0;
     auto all = [](float) { return true; };
-    dof::mergeLists(lists, 4, 0.02f, all, out, dropped);
+    dof::mergeLists(lists, 4, 0.02f, false, all, out, dropped);
     ASSERT_EQ(out.size(), 1u);
     EXPECT_FLOAT_EQ(out[0].a, 1.0f);         // opaque stays opaque
     EXPECT_FLOAT_EQ(out[0].r, 1.75f / 4.0f); // mean colour
@@ -100,7 +104,7 @@ TEST(Multilayer, MergeOpaqueStaysOpaqueAndSilhouettesTurnTransparent) {
     lists[2].count = 0;
     lists[3].count = 0;
     out.clear();
-    dof::mergeLists(lists, 4, 0.02f, all, out, dropped);
+    dof::mergeLists(lists, 4, 0.02f, false, all, out, dropped);
     ASSERT_EQ(out.size(), 1u);
     EXPECT_FLOAT_EQ(out[0].a, 0.5f);
 }
@@ -113,7 +117,7 @@ TEST(Multilayer, MergeUsesOverWithinAListAndSplitsBeyondEpsilon) {
     std::vector<dof::LayerFragment> out;
     uint64_t dropped = 0;
     dof::mergeLists(
-        lists, 1, 0.02f, [](float) { return true; }, out, dropped);
+        lists, 1, 0.02f, false, [](float) { return true; }, out, dropped);
     ASSERT_EQ(out.size(), 2u);
     // α' = 1 - (1 - αa)(1 - αb) = 0.75; α'c' = αa ca + (1 - αa) αb cb = 0.5.
     EXPECT_FLOAT_EQ(out[0].a, 0.75f);
@@ -122,9 +126,33 @@ TEST(Multilayer, MergeUsesOverWithinAListAndSplitsBeyondEpsilon) {
     // ε = 0: three groups; a keep() that drops the far one counts it.
     out.clear();
     dof::mergeLists(
-        lists, 1, 0.0f, [](float d) { return d < 15.0f; }, out, dropped);
+        lists, 1, 0.0f, false, [](float d) { return d < 15.0f; }, out, dropped);
     EXPECT_EQ(out.size(), 2u);
     EXPECT_EQ(dropped, 1u);
+}
+
+TEST(Multilayer, MergeCarriesTheMeanDepthOfWhatItMerged) {
+    // Two lists within ε: an opaque fragment at 10 (weight 3/4) and one at 11 (weight 1/4).
+    // The paper's merged fragment lies at the closest depth, 10; the mean depth weights each
+    // by its visible opacity: 10.25. Within one list the over operator hides what is behind
+    // an opaque fragment, so it adds nothing to the mean. The output stays sorted.
+    const dof::LayerFragment l0[] = {frag(1.0f, 1.0f, 10.0f), frag(1.0f, 1.0f, 10.5f),
+                                     frag(1.0f, 1.0f, 30.0f)};
+    const dof::LayerFragment l1[] = {frag(0.0f, 1.0f, 11.0f)};
+    const dof::ListRef lists[2] = {{l0, 3, 0.75f}, {l1, 1, 0.25f}};
+    auto all = [](float) { return true; };
+    std::vector<dof::LayerFragment> out;
+    uint64_t dropped = 0;
+    dof::mergeLists(lists, 2, 0.2f, false, all, out, dropped);
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_EQ(out[0].depth, 10.0f);
+    out.clear();
+    dof::mergeLists(lists, 2, 0.2f, true, all, out, dropped);
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_FLOAT_EQ(out[0].depth, 10.25f);
+    EXPECT_FLOAT_EQ(out[0].a, 1.0f);
+    EXPECT_FLOAT_EQ(out[1].depth, 30.0f);
+    EXPECT_LE(out[0].depth, out[1].depth);
 }
 
 // --- §6.1 border table --------------------------------------------------------------------
@@ -224,33 +252,138 @@ TEST(Multilayer, ConstantImageStaysConstant) {
 
 TEST(Multilayer, OpaqueSurfacesStayOpaqueThroughTheLevels) {
     // A wall covering the whole view behind the focal plane and a small quad in front of it:
-    // every cell of every level holds the wall with opacity 1 (over-composited list), also
-    // where the quad's silhouette makes its own fragment partly transparent.
+    // every cell of every level, box and aperture-shaped, holds the wall with opacity 1
+    // (over-composited list), also where the quad's silhouette makes its own fragment partly
+    // transparent.
     const raster::View view = testView();
     raster::Scene scene = checkerWall(200.0f);
     const int32_t red = addMaterial(scene, flatMaterial({1.0f, 0.0f, 0.0f, 1.0f}));
     addQuad(scene, -10.0f, -10.0f, 10.0f, 10.0f, 60.0f, red);
-    dof::MultilayerSettings settings;
-    settings.truncate = false;
-    settings.stack_levels = 3;
-    const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus), settings);
-    ASSERT_EQ(ml.levels.size(), 6u);
-    bool partial_seen = false;
-    for (const dof::FragmentLevel& l : ml.levels)
-        for (uint32_t j = 0; j < l.height; ++j)
-            for (uint32_t i = 0; i < l.width; ++i) {
-                uint32_t count = 0;
-                const dof::LayerFragment* f = l.list(i, j, count);
-                float a = 0.0f;
-                for (uint32_t k = 0; k < count; ++k) {
-                    a += (1.0f - a) * f[k].a;
-                    if (f[k].a < 0.99f)
-                        partial_seen = true;
+    for (dof::LevelFilter filter : {dof::LevelFilter::Box, dof::LevelFilter::Aperture}) {
+        dof::MultilayerSettings settings;
+        settings.truncate = false;
+        settings.stack_levels = 3;
+        settings.filter = filter;
+        const MlRun ml =
+            runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus), settings);
+        std::vector<const dof::FragmentLevel*> levels;
+        for (const dof::FragmentLevel& l : ml.levels)
+            levels.push_back(&l);
+        for (const dof::FragmentLevel& l : ml.apertures)
+            levels.push_back(&l);
+        if (filter == dof::LevelFilter::Box)
+            ASSERT_EQ(levels.size(), 5u); // 1 mip + 3 stack levels over the base
+        else
+            ASSERT_GT(ml.apertures.size(), 3u);
+        bool partial_seen = false;
+        for (const dof::FragmentLevel* l : levels)
+            for (uint32_t j = 0; j < l->height; ++j)
+                for (uint32_t i = 0; i < l->width; ++i) {
+                    uint32_t count = 0;
+                    const dof::LayerFragment* f = l->list(i, j, count);
+                    float a = 0.0f;
+                    for (uint32_t k = 0; k < count; ++k) {
+                        a += (1.0f - a) * f[k].a;
+                        if (f[k].a < 0.99f)
+                            partial_seen = true;
+                    }
+                    ASSERT_NEAR(a, 1.0f, 1e-5f) << "level " << l->index << " cell " << i << ","
+                                                << j << (l->grid ? " (aperture)" : "");
+                    ASSERT_NEAR(f[count - 1].depth, 200.0f, 0.5f); // the wall is last
                 }
-                ASSERT_NEAR(a, 1.0f, 1e-5f) << "level " << l.index << " cell " << i << "," << j;
-                ASSERT_NEAR(f[count - 1].depth, 200.0f, 0.5f); // the wall is last
-            }
-    EXPECT_TRUE(partial_seen); // the quad's silhouette
+        EXPECT_TRUE(partial_seen); // the quad's silhouette
+    }
+}
+
+// --- aperture-shaped levels, mean depth, grouped blending --------------------------------
+
+// Two small white squares on black, one behind the focal plane (C = +12 px) and one in front
+// of it (C = -12 px), rendered by accum with 256 lens samples on `shape` and by multilayer.
+struct SpotCase {
+    raster::Scene scene;
+    raster::View view = testView(128, 64);
+    dof::ThinLens lens = dof::makeThinLens(view, 24.0f, kFocus);
+    SpotCase() {
+        const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
+        const float far = 200.0f, near = 200.0f / 3.0f; // C = E f (1/d_f - 1/d) = ±12 px
+        addQuad(scene, -34.0f * far / kFocus, -2.0f * far / kFocus, -30.0f * far / kFocus,
+                2.0f * far / kFocus, far, white);
+        addQuad(scene, 30.0f * near / kFocus, -2.0f * near / kFocus, 34.0f * near / kFocus,
+                2.0f * near / kFocus, near, white);
+    }
+    double psnr(const dof::ApertureShape& lens_shape, const dof::MultilayerSettings& settings) {
+        const raster::Frame ref = renderAccum(scene, view, lens, makeSamples(256, lens_shape));
+        const MlRun ml = runMultilayer(scene, view, lens, settings);
+        const raster::Result<dof::ErrorMetrics> m =
+            dof::compareImages({ref.color.data(), view.width, view.height, 4},
+                               {ml.image.rgba.data(), view.width, view.height, 4});
+        FOCAL_CHECK(m.ok());
+        return m->psnr_linear_db;
+    }
+};
+
+TEST(Multilayer, ApertureLevelsGiveTheBokehTheAperturesShape) {
+    // The paper's box levels turn a point into a square; the aperture levels into the lens's
+    // disc, closer to accum.
+    SpotCase c;
+    dof::MultilayerSettings box;
+    box.filter = dof::LevelFilter::Box;
+    const double psnr_box = c.psnr({}, box);
+    const double psnr_disc = c.psnr({}, {});
+    EXPECT_GT(psnr_disc, psnr_box + 6.0); // measured: 54.2 against 45.1 dB
+    EXPECT_GT(psnr_disc, 50.0);
+    RecordProperty("psnr_box_db", std::to_string(psnr_box));
+    RecordProperty("psnr_aperture_db", std::to_string(psnr_disc));
+}
+
+TEST(Multilayer, ApertureLevelsTurnAnAsymmetricApertureInFrontOfTheFocalPlane) {
+    // A triangle (not symmetric under a half turn): behind the focal plane the bokeh is the
+    // triangle, in front of it the triangle turned by 180 degrees (dof/lens.h). Near and far
+    // aperture levels are built apart; the triangle turned the wrong way scores worse.
+    SpotCase c;
+    dof::ApertureShape triangle;
+    triangle.kind = dof::ApertureKind::Polygon;
+    triangle.blades = 3;
+    dof::MultilayerSettings right;
+    right.aperture = triangle;
+    dof::MultilayerSettings wrong = right;
+    wrong.aperture.rotation_deg = 180.0f;
+    const double psnr_right = c.psnr(triangle, right);
+    const double psnr_wrong = c.psnr(triangle, wrong);
+    EXPECT_GT(psnr_right, psnr_wrong + 5.0); // measured: 49.6 against 41.2 dB
+    EXPECT_GT(psnr_right, 46.0);
+    const MlRun ml = runMultilayer(c.scene, c.view, c.lens, right);
+    EXPECT_TRUE(ml.stats.asymmetric_aperture);
+    EXPECT_EQ(ml.apertures.size(), 2 * ml.stats.apertures.size());
+    RecordProperty("psnr_right_db", std::to_string(psnr_right));
+    RecordProperty("psnr_wrong_db", std::to_string(psnr_wrong));
+}
+
+TEST(Multilayer, LayersFarApartCompositeWithTheOverOperator) {
+    // Two large BLEND panes (α = 0.5), red in focus and green three times farther, over a blue
+    // background. Their depths are far apart, so they are separate groups: the over operator
+    // gives 0.5 red + 0.25 green + 0.25 blue at the centre. The paper's single additive group
+    // (additive_gap = inf) sums the opacities to 1 and hides the background.
+    const raster::View view = testView();
+    raster::Scene scene;
+    scene.background = {0.0f, 0.0f, 1.0f};
+    const int32_t red =
+        addMaterial(scene, flatMaterial({1.0f, 0.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
+    const int32_t green =
+        addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 0.5f}, raster::AlphaMode::Blend));
+    addQuad(scene, -300.0f, -300.0f, 300.0f, 300.0f, 300.0f, green);
+    addQuad(scene, -100.0f, -100.0f, 100.0f, 100.0f, kFocus, red);
+    const dof::ThinLens lens = dof::makeThinLens(view, 2.0f, kFocus);
+    dof::MultilayerSettings settings;
+    settings.color_format = raster::ColorFormat::Float32;
+    const MlRun grouped = runMultilayer(scene, view, lens, settings);
+    EXPECT_NEAR(channel(grouped.image, 32, 32, 0), 0.5f, 1e-3f);
+    EXPECT_NEAR(channel(grouped.image, 32, 32, 1), 0.25f, 1e-3f);
+    EXPECT_NEAR(channel(grouped.image, 32, 32, 2), 0.25f, 1e-3f);
+    settings.additive_gap = std::numeric_limits<float>::infinity();
+    const MlRun one_group = runMultilayer(scene, view, lens, settings);
+    EXPECT_NEAR(channel(one_group.image, 32, 32, 1), 0.5f, 1e-3f);
+    EXPECT_NEAR(channel(one_group.image, 32, 32, 2), 0.0f, 1e-3f);
 }
 
 // Variance of the line-spread function of a vertical step edge in one row (see accum_test.cpp):
@@ -336,9 +469,10 @@ TEST(Multilayer, AutoLevelsCoverTheLargestCoc) {
     const MlRun ml = runMultilayer(scene, view, lens);
     EXPECT_NEAR(ml.stats.max_coc_px, 12.0f, 1e-3f);
     ASSERT_FALSE(ml.stats.levels.empty());
-    EXPECT_GE(ml.stats.levels.back().radius_px, 12.0);
-    EXPECT_LT(ml.stats.levels[ml.stats.levels.size() - 2].radius_px, 12.0);
-    EXPECT_EQ(ml.stats.mip_levels, 2u);
+    ASSERT_GE(ml.stats.traversal.size(), 2u);
+    EXPECT_GE(ml.stats.traversal.back().radius_px, 12.0);
+    EXPECT_LT(ml.stats.traversal[ml.stats.traversal.size() - 2].radius_px, 12.0);
+    EXPECT_EQ(ml.stats.mip_levels, 1u);
 }
 
 TEST(Multilayer, TransparentPaneTintsWhatIsBehindIt) {
@@ -368,10 +502,18 @@ TEST(Multilayer, DeterministicAcrossThreadCounts) {
     const raster::View view = raster::viewFromCamera(scene->cameras[0], 192, 108);
     const dof::ThinLens lens =
         dof::makeThinLens(view, scene->lens->aperture_radius, scene->lens->focus_distance);
-    for (const char* config : {"2/auto", "0/3", "4/0"}) {
+    // Configurations mip/stack, box (b) or aperture levels (a: disc, t: triangle, whose near
+    // and far levels differ).
+    for (const char* config : {"1/auto a", "1/auto t", "2/auto b", "0/3 b", "4/0 b", "4/0 a"}) {
         dof::MultilayerSettings settings;
         settings.mip_levels = uint32_t(config[0] - '0');
         settings.stack_levels = config[2] == 'a' ? -1 : int32_t(config[2] - '0');
+        const char kind = config[std::strlen(config) - 1];
+        settings.filter = kind == 'b' ? dof::LevelFilter::Box : dof::LevelFilter::Aperture;
+        if (kind == 't') {
+            settings.aperture.kind = dof::ApertureKind::Polygon;
+            settings.aperture.blades = 3;
+        }
         const uint64_t h0 = hashImage(runMultilayer(*scene, view, lens, settings, 0).image);
         for (uint32_t threads : {1u, 2u, 3u, 8u})
             EXPECT_EQ(hashImage(runMultilayer(*scene, view, lens, settings, threads).image), h0)
@@ -396,6 +538,16 @@ TEST(Multilayer, BadSettingsNameTheOption) {
     s = {};
     s.epsilon = NAN;
     EXPECT_FALSE(dof::validate(s).ok());
+    s = {};
+    s.aperture_grids = {4, 9};
+    EXPECT_NE(dof::validate(s).message().find("--aperture-grids"), std::string::npos);
+    s.aperture_grids = {4, 8}; // not below twice the first
+    EXPECT_FALSE(dof::validate(s).ok());
+    s.aperture_grids = {5, 4};
+    EXPECT_FALSE(dof::validate(s).ok());
+    s = {};
+    s.additive_gap = NAN;
+    EXPECT_NE(dof::validate(s).message().find("--additive-gap"), std::string::npos);
 }
 
 } // namespace
