@@ -80,9 +80,7 @@ std::vector<Setting> settingsFor(const std::string& method, bool quick) {
     }
     if (method == "multilayer") {
         auto m = [](const char* n) {
-            return Setting{
-                std::string("frags=") + n,
-                {"--fragments-per-pixel", n, "--mip-levels", "2", "--stack-levels", "auto"}};
+            return Setting{std::string("frags=") + n, {"--fragments-per-pixel", n}};
         };
         if (quick)
             return {m("4")};
