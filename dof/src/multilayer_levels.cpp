@@ -277,16 +277,19 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
         auto keep = [&](float d) { return !plan.truncate || !truncatedAt(borders, level, d); };
         ListRef src[kMaxMergeLists];
         for (uint32_t i = 0; i < out.width; ++i) {
+            // Empty taps add nothing to the merge (x + w·0 = x), so only the others are passed,
+            // in grid order: the same bytes, less work where the view shows background.
+            uint32_t used = 0;
             for (size_t k = 0; k < taps.size(); ++k) {
                 // Border cells clamped, as the stack's (Fig. 4).
                 const int32_t x = std::clamp(int32_t(i) + taps[k].a, 0, max_x);
                 const int32_t y = std::clamp(int32_t(j) + taps[k].b, 0, max_y);
-                src[k].data = box.list(uint32_t(x), uint32_t(y), src[k].count);
-                src[k].weight = taps[k].weight;
+                src[used].data = box.list(uint32_t(x), uint32_t(y), src[used].count);
+                src[used].weight = taps[k].weight;
+                used += src[used].count > 0 ? 1 : 0;
             }
             starts[i] = uint32_t(row.size());
-            mergeLists(src, uint32_t(taps.size()), plan.epsilon, plan.mean_depth, keep, row,
-                       dropped[j]);
+            mergeLists(src, used, plan.epsilon, plan.mean_depth, keep, row, dropped[j]);
             longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
         }
         starts[out.width] = uint32_t(row.size());
