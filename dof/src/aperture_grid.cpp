@@ -34,15 +34,15 @@ raster::Result<ApertureGrid> apertureGrid(const ApertureShape& shape, uint32_t s
         return raster::Status::error("aperture grid: the aperture lets no light through");
     // A circle and a polygon with an even blade count are symmetric under a half turn: average
     // each cell with its mirror cell so that the near and far grids are the same bits.
-    const bool half_turn_symmetric =
-        shape.kind == ApertureKind::Circle ||
-        (shape.kind == ApertureKind::Polygon && shape.blades % 2 == 0);
+    const bool half_turn_symmetric = shape.kind == ApertureKind::Circle ||
+                                     (shape.kind == ApertureKind::Polygon && shape.blades % 2 == 0);
     const size_t cells = mass.size();
     grid.weight.resize(cells);
     for (size_t i = 0; i < cells; ++i) {
         // In front of the focal plane the offset is -R·(-v.x, +v.y): the grid turned by 180°.
         const size_t src = side == FocalSide::Far ? i : cells - 1 - i;
-        const double m = half_turn_symmetric ? 0.5 * (mass[src] + mass[cells - 1 - src]) : mass[src];
+        const double m =
+            half_turn_symmetric ? 0.5 * (mass[src] + mass[cells - 1 - src]) : mass[src];
         grid.weight[i] = float(m / total);
     }
     grid.second_moment = m2 / total;

@@ -1,5 +1,4 @@
 #include <dof/multilayer.h>
-
 #include <raster/check.h>
 
 #include <algorithm>
@@ -62,7 +61,7 @@ struct Plan {
 };
 
 // T over the boxes: the boxes themselves, or box 0 and then the aperture levels of box 0, 1, ...
-// (two per box: G = grid and G = grid_mid), each kept only if it blurs more than the previous
+// (one per grid of settings.aperture_grids), each kept only if it blurs more than the previous
 // one, up to the first whose radius reaches the largest |C| of the frame.
 void planTraversal(Plan& p, uint32_t width, uint32_t height, const MultilayerSettings& settings,
                    const std::vector<ApertureGrid>& grids, double m2, float max_coc_px) {
@@ -170,7 +169,7 @@ raster::Status validate(const MultilayerSettings& s) {
         return Status::error("the fragment node capacity must be at least 1");
     if (s.filter == LevelFilter::Aperture) {
         const std::vector<uint32_t>& g = s.aperture_grids;
-        bool good = !g.empty() && g.size() <= kMaxApertureGrid;
+        bool good = !g.empty() && g.size() <= kMaxApertureGridsPerBox;
         for (size_t i = 0; good && i < g.size(); ++i)
             good = g[i] >= 2 && g[i] <= kMaxApertureGrid && g[i] < 2 * g[0] &&
                    (i == 0 || g[i] > g[i - 1]);
@@ -245,7 +244,9 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                                 std::fabs(cocRadiusPx(lens, row_max[y]))});
     const double ms_base = msSince(t0);
 
-    // The aperture drawn on the tap grids, for both sides of the focal plane.
+    // The aperture drawn on the tap grids, for both sides of the focal plane (timed with the
+    // filter stage, which they belong to).
+    t0 = std::chrono::steady_clock::now();
     const bool shaped = settings.filter == LevelFilter::Aperture;
     std::vector<ApertureGrid> grids[2]; // [far, near], one per settings.aperture_grids
     double m2 = settings.aperture_second_moment;
@@ -264,13 +265,12 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     }
 
     // §5: plan the Y-map and T, compute the border table (§6.1), filter level by level.
-    t0 = std::chrono::steady_clock::now();
     Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
     borders_ = levelBorders(lens, plan.variance, m2);
-    const uint32_t boxes_needed = std::min(
-        uint32_t(plan.boxes.size()),
-        shaped ? plan.apertures.empty() ? 1u : plan.apertures.back().source + 1u
-               : uint32_t(plan.boxes.size()));
+    const uint32_t boxes_needed =
+        std::min(uint32_t(plan.boxes.size()),
+                 shaped ? plan.apertures.empty() ? 1u : plan.apertures.back().source + 1u
+                        : uint32_t(plan.boxes.size()));
     levels_.resize(boxes_needed);
     for (uint32_t s = 1; s < boxes_needed; ++s) {
         FragmentLevel& l = levels_[s];
@@ -305,14 +305,14 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
 
     // The levels of T on each side of the focal plane ([near, far]).
     const uint32_t n = uint32_t(plan.traversal.size()) - 1;
-    constexpr uint32_t kMaxT = 2 * (kMaxFilterLevels + 1) + 1;
+    constexpr uint32_t kMaxT = kMaxTraversalLevels;
     FOCAL_CHECK(n + 1 <= kMaxT);
     const FragmentLevel* tlevel[2][kMaxT] = {};
     for (uint32_t s = 0; s <= n; ++s) {
         const Plan::Entry& e = plan.traversal[s];
         tlevel[1][s] = e.aperture ? &apertures_[e.level] : &levels_[e.level];
-        tlevel[0][s] = e.aperture && asymmetric ? &apertures_[shaped_count + e.level]
-                                                : tlevel[1][s];
+        tlevel[0][s] =
+            e.aperture && asymmetric ? &apertures_[shaped_count + e.level] : tlevel[1][s];
     }
     // T as segments; with an asymmetric aperture the one across the focal plane is split there,
     // so that every slice reads the levels of its own side.
@@ -494,8 +494,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             st.slices_blended += c;
         for (const FragmentLevel& l : levels_)
             st.levels.push_back(levelStats(l));
-        for (size_t a = 0; a < shaped_count; ++a)
-            st.apertures.push_back(levelStats(apertures_[a]));
+        for (const FragmentLevel& l : apertures_)
+            st.apertures.push_back(levelStats(l));
         for (uint32_t s = 0; s <= n; ++s) {
             MultilayerTraversalStats ts;
             ts.index = s;

@@ -1,10 +1,9 @@
 #include <dof/fragment_levels.h>
+#include <raster/check.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <raster/check.h>
 
 namespace dof {
 namespace {
@@ -214,8 +213,8 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
     sumRows(longest, dropped, next);
 }
 
-FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& grid,
-                                uint32_t index, uint32_t base_width, uint32_t base_height) {
+FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& grid, uint32_t index,
+                                uint32_t base_width, uint32_t base_height) {
     FragmentLevel level;
     level.index = index;
     level.kind = LevelKind::Aperture;
@@ -268,7 +267,8 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
     for (uint32_t b = 0; b < grid.size; ++b)
         for (uint32_t a = 0; a < grid.size; ++a)
             if (grid.at(a, b) > 0.0f)
-                taps.push_back({int32_t(a) * step - reach, int32_t(b) * step - reach, grid.at(a, b)});
+                taps.push_back(
+                    {int32_t(a) * step - reach, int32_t(b) * step - reach, grid.at(a, b)});
     const uint32_t level = out.index;
     pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
         std::vector<LayerFragment>& row = out.rows[j];

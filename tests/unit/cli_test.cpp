@@ -272,6 +272,21 @@ TEST_F(Cli, DepthOutputMustBeExr) {
     EXPECT_TRUE(files().empty()) << ::testing::PrintToString(files());
 }
 
+TEST_F(Cli, BadMultilayerSettingsNameTheOption) {
+    // Values CLI11 accepts as text but the method rejects: exit 1, one line naming the option.
+    for (const std::vector<std::string>& extra :
+         {std::vector<std::string>{"--additive-gap", "-1"},
+          std::vector<std::string>{"--additive-gap", "wide"},
+          std::vector<std::string>{"--aperture-grids", "4,9"}}) {
+        std::vector<std::string> args = renderArgs({"--method", "multilayer"});
+        args.insert(args.end(), extra.begin(), extra.end());
+        const ProcessResult r = focal(args);
+        EXPECT_TRUE(failedWithOneErrorLine(r, 1)) << extra[0] << " " << extra[1];
+        EXPECT_TRUE(contains(r.err, extra[0])) << r.err;
+        EXPECT_TRUE(files().empty()) << ::testing::PrintToString(files());
+    }
+}
+
 // Every malformed fixture in tests/data/gltf/bad fails cleanly (a name per fixture: fixture
 // file name with '.' as '_').
 std::vector<std::string> badFixtures() {

@@ -19,9 +19,12 @@
 
 namespace dof {
 
+// The side of the focal plane. The bokeh there (what a point light looks like) is the aperture
+// turned by 180 degrees in front of it and upright behind it (dof/lens.h); a gather grid is the
+// bokeh turned by 180 degrees.
 enum class FocalSide : uint8_t {
-    Near, // in front of the focal plane, C < 0: the aperture turned by 180 degrees
-    Far,  // behind it, C > 0: the aperture upright
+    Near, // in front of the focal plane, C < 0
+    Far,  // behind it, C > 0
 };
 
 struct ApertureGrid {

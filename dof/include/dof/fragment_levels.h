@@ -4,8 +4,9 @@
 // Aperture-shaped levels read a box level through a grid of taps weighted by the aperture
 // (dof/aperture_grid.h), so that the blur they stand for has the lens's shape (the paper's §5.2
 // names other filters as possible; §8 suggests per-level post-processing). Also the per-frame
-// level border table T (§6.1) and the truncation rule (§6.2) that both follow from the thin lens. Consumes raster::FragmentLists and a ThinLens; produces FragmentLevels that
-// the caller owns (FragmentHierarchy keeps their memory between frames).
+// level border table T (§6.1) and the truncation rule (§6.2) that both follow from the thin
+// lens. Consumes raster::FragmentLists and a ThinLens; produces FragmentLevels that the caller
+// owns (dof::Multilayer keeps their memory between frames).
 //
 // Fragments are stored premultiplied: (α·c, α, d). The paper's merged colour c' is stored as α'c',
 // which makes the over operator and the additive combine of §5.1 plain sums (no 1/α').
@@ -15,6 +16,7 @@
 #include <dof/aperture_grid.h>
 #include <dof/lens.h>
 #include <raster/camera.h>
+#include <raster/check.h>
 #include <raster/fragment_lists.h>
 #include <raster/status.h>
 #include <raster/task_pool.h>
@@ -35,9 +37,9 @@ struct LayerFragment {
 };
 
 enum class LevelKind : uint8_t {
-    Base,  // level 0: the collected lists (§4)
-    Mip,   // 2x2 lists of the level below merged into one, half the resolution (§5.1)
-    Stack, // 2x2 box without downsampling: the image grows by the dilation per level (§5.2)
+    Base,     // level 0: the collected lists (§4)
+    Mip,      // 2x2 lists of the level below merged into one, half the resolution (§5.1)
+    Stack,    // 2x2 box without downsampling: the image grows by the dilation per level (§5.2)
     Aperture, // G x G taps of a box level, 2^source base pixels apart, weighted by the aperture
               // (dof/aperture_grid.h): a disc (or polygon, or image) of diameter G·2^source
 };
@@ -48,7 +50,9 @@ enum class LevelKind : uint8_t {
 //
 // Geometry: cell (i, j) is centred at base-pixel coordinates
 //   (origin_x + i·spacing, origin_y + j·spacing)           (pixel p's centre is p + 1/2)
-// and holds a 2^S x 2^S box filter of the base level's point samples (S = index).
+// and holds a 2^S x 2^S box filter of the base level's point samples (box levels: S = index;
+// an aperture level holds its grid of taps of box level `source`, and `index` is its place in
+// T).
 struct FragmentLevel {
     uint32_t index = 0;
     LevelKind kind = LevelKind::Base;
@@ -101,6 +105,11 @@ struct LevelPlan {
 constexpr uint32_t kMaxFilterLevels = 12;
 constexpr uint32_t kMaxApertureGrid = 8; // taps per axis of an aperture-shaped level
 constexpr uint32_t kMaxMergeLists = kMaxApertureGrid * kMaxApertureGrid;
+// Aperture levels built from one box level: grids G increasing in [G0, 2·G0) with G0 >= 2 and
+// G <= kMaxApertureGrid allow at most four (e.g. 4,5,6,7 or 5,6,7,8).
+constexpr uint32_t kMaxApertureGridsPerBox = 4;
+// Levels of T: the base and, at most, every grid of every box level.
+constexpr uint32_t kMaxTraversalLevels = 1 + (kMaxFilterLevels + 1) * kMaxApertureGridsPerBox;
 
 // The level border table T of §6.1, computed per frame. The paper matches Coc(z) = F|z - z_f|
 // with the level's filter size fs_S(z) = 2^S G z; in pixels that is |C(d)| = r_S with r_S
@@ -146,8 +155,8 @@ inline bool truncatedAt(const LevelBorders& borders, uint32_t level, float depth
 }
 
 // §5.1 merge of up to kMaxMergeLists depth-sorted lists into one sorted list, like merge
-// sort's combine: take the closest fragment d0 of all lists; from every list take its fragments with
-// d <= d0·(1 + ε) and blend them with the over operator (front to back, within one list); add
+// sort's combine: take the closest fragment d0 of all lists; from every list take its fragments
+// with d <= d0·(1 + ε) and blend them with the over operator (front to back, within one list); add
 // the lists' results weighted (the paper: 1/4 each for 2x2 lists, empty lists count as α' = 0);
 // emit (Σ w α'c', Σ w α', depth) with depth d0 or, with mean_depth, the mean depth of what was
 // merged weighted by its visible opacity (in [d0, d0·(1 + ε)], so the output stays sorted);
@@ -182,8 +191,8 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
 // 2^box.index base pixels apart (an integer number of box cells, border cells clamped), so the
 // level covers a G·2^box.index square and keeps box's cell spacing; the image grows by the
 // taps' reach. `index` is the level's place in T.
-FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& grid,
-                                uint32_t index, uint32_t base_width, uint32_t base_height);
+FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& grid, uint32_t index,
+                                uint32_t base_width, uint32_t base_height);
 
 // Fills the aperture-shaped level `out` (geometry from planApertureLevel) by the §5.1 merge of
 // its G x G taps, weighted by the grid (disjoint areas: additive across taps), one task per row
@@ -197,6 +206,7 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
 template <class Keep>
 void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
                 Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped) {
+    FOCAL_CHECK(list_count <= kMaxMergeLists);
     uint32_t cursor[kMaxMergeLists];
     std::fill_n(cursor, list_count, 0u);
     const float scale = 1.0f + epsilon;

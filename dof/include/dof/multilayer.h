@@ -97,9 +97,9 @@ struct MultilayerLevelStats {
 
 // One level of the border table T (§6.1): the level the traversal reads between its borders.
 struct MultilayerTraversalStats {
-    uint32_t index = 0;    // S in T
+    uint32_t index = 0; // S in T
     LevelKind kind = LevelKind::Base;
-    uint32_t level = 0;    // Box: index into MultilayerStats::levels; Aperture: into apertures
+    uint32_t level = 0;     // Box: index into MultilayerStats::levels; Aperture: into apertures
     double radius_px = 0.0; // r_S: the |C| this level matches
     float z_near = 0.0f;    // z_{N,S}
     float z_far = 0.0f;     // z_{F,S} (+inf past the plateau)
@@ -116,13 +116,16 @@ struct MultilayerStats {
     bool node_pool_grew = false;
     uint32_t mip_levels = 0;
     uint32_t stack_levels = 0;
-    float max_coc_px = 0.0f;     // largest |C(d)| over the collected fragments
-    uint64_t slices_blended = 0; // merged slices composited during the traversal
-    double second_moment = 0.0;  // m2 the border table used
+    float max_coc_px = 0.0f;          // largest |C(d)| over the collected fragments
+    uint64_t slices_blended = 0;      // merged slices composited during the traversal
+    double second_moment = 0.0;       // m2 the border table used
     bool asymmetric_aperture = false; // near and far aperture levels built apart
-    std::vector<MultilayerLevelStats> levels;    // the box hierarchy (§5)
-    std::vector<MultilayerLevelStats> apertures; // aperture levels (far side; the near side
-                                                 // mirrors it when asymmetric_aperture)
+    // The box levels built (§5): those T reads, directly or through aperture levels, so fewer
+    // than mip_levels + stack_levels + 1 when the frame's blur needs fewer.
+    std::vector<MultilayerLevelStats> levels;
+    // Aperture levels in T order, far side first; with asymmetric_aperture the near side's
+    // follow in the same order.
+    std::vector<MultilayerLevelStats> apertures;
     std::vector<MultilayerTraversalStats> traversal; // T
 };
 

@@ -21,7 +21,7 @@ TEST(ApertureGrid, CircleIsTheSameOnBothSidesAndRound) {
     raster::Result<dof::ApertureGrid> near = dof::apertureGrid({}, 6, dof::FocalSide::Near);
     ASSERT_TRUE(far.ok() && near.ok());
     EXPECT_NEAR(sum(*far), 1.0, 1e-6);
-    EXPECT_TRUE(dof::sameWeights(*far, *near)); // symmetric under a half turn, bit for bit
+    EXPECT_TRUE(dof::sameWeights(*far, *near));  // symmetric under a half turn, bit for bit
     EXPECT_NEAR(far->second_moment, 0.25, 1e-3); // the uniform disk
     // A corner cell, [2/3, 1]^2 of the lens square, meets the unit disk in a sliver of area
     // ~0.0033 (share ~0.001); a centre cell lies inside it: share (1/3)^2 / pi ~ 0.035.
@@ -61,6 +61,27 @@ TEST(ApertureGrid, TriangleTurnsInFrontOfTheFocalPlane) {
     EXPECT_GT(row(*far, 1), 2.0 * row(*far, 3));
     EXPECT_NEAR(row(*far, 0), 0.0, 1e-6); // nothing below the base at lens y = -1/2
     EXPECT_GT(row(*near, 2), 2.0 * row(*near, 0));
+}
+
+TEST(ApertureGrid, TriangleOnItsSideMirrorsInXBehindTheFocalPlane) {
+    // Turned by 90 degrees the triangle's tip points to lens -x and its base stands at lens
+    // x = +1/2. Behind the focal plane the gather reads image offset -v.x: the tip's mass sits in
+    // the right column (a = 3), the base's in column 1, and column 0 (lens x > 1/2) is empty.
+    dof::ApertureShape triangle;
+    triangle.kind = dof::ApertureKind::Polygon;
+    triangle.blades = 3;
+    triangle.rotation_deg = 90.0f;
+    raster::Result<dof::ApertureGrid> far = dof::apertureGrid(triangle, 4, dof::FocalSide::Far);
+    ASSERT_TRUE(far.ok());
+    auto column = [&](uint32_t a) {
+        double c = 0.0;
+        for (uint32_t b = 0; b < 4; ++b)
+            c += double(far->at(a, b));
+        return c;
+    };
+    EXPECT_NEAR(column(0), 0.0, 1e-6);
+    EXPECT_GT(column(1), 2.0 * column(3));
+    EXPECT_GT(column(3), 0.0);
 }
 
 TEST(ApertureGrid, BadInputIsAnError) {

@@ -287,8 +287,8 @@ TEST(Multilayer, OpaqueSurfacesStayOpaqueThroughTheLevels) {
                         if (f[k].a < 0.99f)
                             partial_seen = true;
                     }
-                    ASSERT_NEAR(a, 1.0f, 1e-5f) << "level " << l->index << " cell " << i << ","
-                                                << j << (l->grid ? " (aperture)" : "");
+                    ASSERT_NEAR(a, 1.0f, 1e-5f) << "level " << l->index << " cell " << i << "," << j
+                                                << (l->grid ? " (aperture)" : "");
                     ASSERT_NEAR(f[count - 1].depth, 200.0f, 0.5f); // the wall is last
                 }
         EXPECT_TRUE(partial_seen); // the quad's silhouette
@@ -354,9 +354,30 @@ TEST(Multilayer, ApertureLevelsTurnAnAsymmetricApertureInFrontOfTheFocalPlane) {
     EXPECT_GT(psnr_right, 46.0);
     const MlRun ml = runMultilayer(c.scene, c.view, c.lens, right);
     EXPECT_TRUE(ml.stats.asymmetric_aperture);
-    EXPECT_EQ(ml.apertures.size(), 2 * ml.stats.apertures.size());
+    // Near and far aperture levels, the same number of each.
+    EXPECT_EQ(ml.apertures.size(), ml.stats.apertures.size());
+    EXPECT_EQ(ml.apertures.size(), 2 * (ml.stats.traversal.size() - 1));
     RecordProperty("psnr_right_db", std::to_string(psnr_right));
     RecordProperty("psnr_wrong_db", std::to_string(psnr_wrong));
+}
+
+TEST(Multilayer, HugeBlurWithFourGridsPerBoxLevel) {
+    // A wall filling the view at C = -320 px with four grids per box level: T holds more
+    // levels than two grids per box level could (1 + 13·2), and the uniform wall stays uniform.
+    const raster::View view = testView();
+    const float d = 20.0f; // C = E f (1/d_f - 1/d) = -4 E
+    raster::Scene scene;
+    const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
+    addQuad(scene, -100.0f, -100.0f, 100.0f, 100.0f, d, white);
+    dof::MultilayerSettings settings;
+    settings.aperture_grids = {5, 6, 7, 8};
+    const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 80.0f, kFocus), settings);
+    EXPECT_NEAR(ml.stats.max_coc_px, 320.0f, 0.5f);
+    EXPECT_GT(ml.stats.traversal.size(), 27u);
+    EXPECT_GE(ml.stats.traversal.back().radius_px, 320.0);
+    for (uint32_t y = 0; y < kH; y += 7)
+        for (uint32_t x = 0; x < kW; x += 7)
+            ASSERT_NEAR(channel(ml.image, x, y, 0), 1.0f, 1e-4f) << x << "," << y;
 }
 
 TEST(Multilayer, LayersFarApartCompositeWithTheOverOperator) {
@@ -450,10 +471,13 @@ TEST(Multilayer, TruncationKeepsTheImageAndShortensLists) {
     settings.truncate = true;
     const MlRun cut = runMultilayer(scene, view, lens, settings);
     uint64_t full_frags = 0, cut_frags = 0, dropped = 0;
-    for (const dof::MultilayerLevelStats& l : full.stats.levels)
-        full_frags += l.fragments;
-    for (const dof::MultilayerLevelStats& l : cut.stats.levels)
-        cut_frags += l.fragments, dropped += l.truncated;
+    // Box and aperture levels (the default filter) counted together.
+    for (const auto* levels : {&full.stats.levels, &full.stats.apertures})
+        for (const dof::MultilayerLevelStats& l : *levels)
+            full_frags += l.fragments;
+    for (const auto* levels : {&cut.stats.levels, &cut.stats.apertures})
+        for (const dof::MultilayerLevelStats& l : *levels)
+            cut_frags += l.fragments, dropped += l.truncated;
     EXPECT_LT(cut_frags, full_frags);
     EXPECT_GT(dropped, 0u);
     float max_diff = 0.0f;
