@@ -60,14 +60,9 @@ struct Plan {
     double radius(size_t s, double m2) const { return std::sqrt(variance[s] / m2); }
 };
 
-// An aperture level joins T only if its radius is at least this factor above the previous
-// level's: a closer one adds a full level's cost and hardly a new blur size (with the default
-// grids it drops A(L=0, G=5), 12 % above A(0, 4); 11 % fewer instructions per frame).
-constexpr double kMinRadiusStep = 1.15;
-
 // T over the boxes: the boxes themselves, or box 0 and then the aperture levels of box 0, 1, ...
-// (one per grid of settings.aperture_grids), each kept only if its radius is kMinRadiusStep
-// above the previous level's, up to the first whose radius reaches the largest |C| of the frame.
+// (one per grid of settings.aperture_grids), each kept only if it blurs more than the previous
+// one, up to the first whose radius reaches the largest |C| of the frame.
 void planTraversal(Plan& p, uint32_t width, uint32_t height, const MultilayerSettings& settings,
                    const std::vector<ApertureGrid>& grids, double m2, float max_coc_px) {
     p.apertures.clear();
@@ -88,7 +83,7 @@ void planTraversal(Plan& p, uint32_t width, uint32_t height, const MultilayerSet
                 return;
             FragmentLevel a =
                 planApertureLevel(box, grid, uint32_t(p.traversal.size()), width, height);
-            if (!(a.variance() > p.variance.back() * kMinRadiusStep * kMinRadiusStep))
+            if (!(a.variance() > p.variance.back()))
                 continue;
             p.traversal.push_back({true, uint32_t(p.apertures.size())});
             p.variance.push_back(a.variance());

@@ -363,15 +363,14 @@ TEST(Multilayer, ApertureLevelsTurnAnAsymmetricApertureInFrontOfTheFocalPlane) {
 
 TEST(Multilayer, HugeBlurWithFourGridsPerBoxLevel) {
     // A wall filling the view at C = -320 px with four grids per box level: T holds more
-    // levels than two grids per box level could (1 + 13·2; a fixed array of that size aborted
-    // here), and the uniform wall stays uniform.
+    // levels than two grids per box level could (1 + 13·2), and the uniform wall stays uniform.
     const raster::View view = testView();
     const float d = 20.0f; // C = E f (1/d_f - 1/d) = -4 E
     raster::Scene scene;
     const int32_t white = addMaterial(scene, flatMaterial({1.0f, 1.0f, 1.0f, 1.0f}));
     addQuad(scene, -100.0f, -100.0f, 100.0f, 100.0f, d, white);
     dof::MultilayerSettings settings;
-    settings.aperture_grids = {4, 5, 6, 7};
+    settings.aperture_grids = {5, 6, 7, 8};
     const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 80.0f, kFocus), settings);
     EXPECT_NEAR(ml.stats.max_coc_px, 320.0f, 0.5f);
     EXPECT_GT(ml.stats.traversal.size(), 27u);
