@@ -85,8 +85,9 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     } else {
         const char* first = args.additive_gap.data();
         const char* last = first + args.additive_gap.size();
+        // The range is checked with the other settings (dof::validate).
         const std::from_chars_result r = std::from_chars(first, last, settings.additive_gap);
-        if (r.ec != std::errc() || r.ptr != last || !(settings.additive_gap >= 0.0f))
+        if (r.ec != std::errc() || r.ptr != last)
             return raster::Status::error("--additive-gap must be a relative depth gap >= 0 or "
                                          "'inf', got '" +
                                          args.additive_gap + "'");

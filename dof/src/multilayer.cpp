@@ -126,6 +126,16 @@ uint32_t firstReader(const Plan& p, uint32_t box) {
     return uint32_t(p.traversal.size());
 }
 
+// Gives `level` the geometry of `geometry` (from planLevels or planApertureLevel) and keeps its
+// rows' memory, so that a warm Multilayer does not reallocate them.
+void adoptGeometry(const FragmentLevel& geometry, FragmentLevel& level) {
+    std::vector<std::vector<LayerFragment>> rows = std::move(level.rows);
+    std::vector<uint32_t> starts = std::move(level.starts);
+    level = geometry;
+    level.rows = std::move(rows);
+    level.starts = std::move(starts);
+}
+
 MultilayerLevelStats levelStats(const FragmentLevel& l) {
     MultilayerLevelStats ls;
     ls.index = l.index;
@@ -267,36 +277,23 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     // §5: plan the Y-map and T, compute the border table (§6.1), filter level by level.
     Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
     borders_ = levelBorders(lens, plan.variance, m2);
-    const uint32_t boxes_needed =
-        std::min(uint32_t(plan.boxes.size()),
-                 shaped ? plan.apertures.empty() ? 1u : plan.apertures.back().source + 1u
-                        : uint32_t(plan.boxes.size()));
+    // Box levels up to the highest one T reads (all of them with box levels).
+    uint32_t boxes_needed = uint32_t(plan.boxes.size());
+    if (shaped)
+        boxes_needed = plan.apertures.empty() ? 1u : plan.apertures.back().source + 1u;
     levels_.resize(boxes_needed);
     for (uint32_t s = 1; s < boxes_needed; ++s) {
         FragmentLevel& l = levels_[s];
-        const FragmentLevel& g = plan.boxes[s];
-        l.index = g.index;
-        l.kind = g.kind;
-        l.width = g.width;
-        l.height = g.height;
-        l.spacing = g.spacing;
-        l.origin_x = g.origin_x;
-        l.origin_y = g.origin_y;
-        l.dilation = g.dilation;
-        l.filter_variance = g.filter_variance;
-        l.lookup_variance = g.lookup_variance;
+        adoptGeometry(plan.boxes[s], l);
         filterLevel(levels_[s - 1], plan.plan, borders_, firstReader(plan, s), pool, l);
     }
-    // Aperture levels, far side then (asymmetric aperture) near side; rows of each level
-    // reuse their memory between frames.
+    // Aperture levels, far side then (asymmetric aperture) near side.
     const size_t shaped_count = plan.apertures.size();
     apertures_.resize(asymmetric ? 2 * shaped_count : shaped_count);
     for (size_t side = 0; side < (asymmetric ? 2u : 1u); ++side)
         for (size_t a = 0; a < shaped_count; ++a) {
             FragmentLevel& l = apertures_[side * shaped_count + a];
-            std::vector<std::vector<LayerFragment>> rows = std::move(l.rows);
-            l = plan.apertures[a];
-            l.rows = std::move(rows);
+            adoptGeometry(plan.apertures[a], l);
             const auto grid = std::find_if(grids[side].begin(), grids[side].end(),
                                            [&](const ApertureGrid& g) { return g.size == l.grid; });
             shapeLevel(levels_[l.source], *grid, plan.plan, borders_, pool, l);
@@ -305,9 +302,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
 
     // The levels of T on each side of the focal plane ([near, far]).
     const uint32_t n = uint32_t(plan.traversal.size()) - 1;
-    constexpr uint32_t kMaxT = kMaxTraversalLevels;
-    FOCAL_CHECK(n + 1 <= kMaxT);
-    const FragmentLevel* tlevel[2][kMaxT] = {};
+    FOCAL_CHECK(n + 1 <= kMaxTraversalLevels);
+    const FragmentLevel* tlevel[2][kMaxTraversalLevels] = {};
     for (uint32_t s = 0; s <= n; ++s) {
         const Plan::Entry& e = plan.traversal[s];
         tlevel[1][s] = e.aperture ? &apertures_[e.level] : &levels_[e.level];
@@ -349,8 +345,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         settings.blend == LayerBlend::Additive ? 1.0f + settings.additive_gap : 0.0f;
     std::vector<uint64_t> row_slices(height, 0);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
-        Cursor cursors[2][kMaxT][4];
-        uint32_t cursor_count[2][kMaxT];
+        Cursor cursors[2][kMaxTraversalLevels][4];
+        uint32_t cursor_count[2][kMaxTraversalLevels];
         for (uint32_t x = 0; x < width; ++x) {
             const size_t p = size_t(y) * width + x;
             // Bilinear taps of every level at the pixel centre (zero weights skipped).
@@ -385,7 +381,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                 if (ca >= kOpaque)
                     break;
                 const uint32_t side = sides == 2 && seg.begin >= lens.focus_distance ? 1 : 0;
-                Cursor(&cur_side)[kMaxT][4] = cursors[side];
+                Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
                 const uint32_t* count_side = cursor_count[side];
                 const uint32_t lv[2] = {seg.lo, seg.hi};
                 const uint32_t classes = seg.hi == seg.lo ? 1 : 2;

@@ -35,6 +35,36 @@ void sumRows(const std::vector<uint32_t>& longest, const std::vector<uint64_t>& 
     }
 }
 
+// Fills every cell of `out` with the §5.1 merge of the lists `sources(i, j, src)` writes into
+// src (returning how many), one task per row of cells and the cells of a row in order, so the
+// bytes do not depend on the thread count. With plan.truncate, merged fragments that level
+// `border_level` of T and every level above it never ask for are dropped (truncatedAt).
+template <class Sources>
+void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t border_level,
+                raster::TaskPool& pool, FragmentLevel& out, Sources&& sources) {
+    out.rows.resize(out.height);
+    out.starts.assign(size_t(out.height) * (out.width + 1), 0);
+    std::vector<uint32_t> longest(out.height, 0);
+    std::vector<uint64_t> dropped(out.height, 0);
+    pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
+        std::vector<LayerFragment>& row = out.rows[j];
+        row.clear();
+        uint32_t* starts = out.starts.data() + size_t(j) * (out.width + 1);
+        auto keep = [&](float d) {
+            return !plan.truncate || !truncatedAt(borders, border_level, d);
+        };
+        ListRef src[kMaxMergeLists];
+        for (uint32_t i = 0; i < out.width; ++i) {
+            const uint32_t count = sources(i, j, src);
+            starts[i] = uint32_t(row.size());
+            mergeLists(src, count, plan.epsilon, plan.mean_depth, keep, row, dropped[j]);
+            longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
+        }
+        starts[out.width] = uint32_t(row.size());
+    });
+    sumRows(longest, dropped, out);
+}
+
 void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_height) {
     const double n = std::ldexp(1.0, int(level.index)); // 2^S point samples per axis
     level.filter_variance = (n * n - 1.0) / 12.0;       // discrete box of 2^S samples
@@ -176,41 +206,24 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
 
 void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBorders& borders,
                  uint32_t border_level, raster::TaskPool& pool, FragmentLevel& next) {
-    next.rows.resize(next.height);
-    next.starts.assign(size_t(next.height) * (next.width + 1), 0);
-    std::vector<uint32_t> longest(next.height, 0);
-    std::vector<uint64_t> dropped(next.height, 0);
     const bool mip = next.kind == LevelKind::Mip;
     const int32_t delta = int32_t(next.dilation);
     const int32_t max_x = int32_t(prev.width) - 1;
     const int32_t max_y = int32_t(prev.height) - 1;
-    pool.parallelFor(next.height, [&](uint32_t j, uint32_t) {
-        std::vector<LayerFragment>& row = next.rows[j];
-        row.clear();
-        uint32_t* starts = next.starts.data() + size_t(j) * (next.width + 1);
-        // Source rows and columns: mip 2j, 2j+1; stack j-Δ, j (border cells clamped, Fig. 4).
+    mergeCells(plan, borders, border_level, pool, next, [&](uint32_t i, uint32_t j, ListRef* src) {
+        // Source rows and columns: mip 2i, 2i+1; stack i-Δ, i (border cells clamped, Fig. 4).
+        const int32_t x0 = std::clamp(mip ? 2 * int32_t(i) : int32_t(i) - delta, 0, max_x);
+        const int32_t x1 = std::clamp(mip ? 2 * int32_t(i) + 1 : int32_t(i), 0, max_x);
         const int32_t y0 = std::clamp(mip ? 2 * int32_t(j) : int32_t(j) - delta, 0, max_y);
         const int32_t y1 = std::clamp(mip ? 2 * int32_t(j) + 1 : int32_t(j), 0, max_y);
-        auto keep = [&](float d) {
-            return !plan.truncate || !truncatedAt(borders, border_level, d);
-        };
-        for (uint32_t i = 0; i < next.width; ++i) {
-            const int32_t x0 = std::clamp(mip ? 2 * int32_t(i) : int32_t(i) - delta, 0, max_x);
-            const int32_t x1 = std::clamp(mip ? 2 * int32_t(i) + 1 : int32_t(i), 0, max_x);
-            ListRef src[4];
-            const int32_t xs[4] = {x0, x1, x0, x1};
-            const int32_t ys[4] = {y0, y0, y1, y1};
-            for (int k = 0; k < 4; ++k) {
-                src[k].data = prev.list(uint32_t(xs[k]), uint32_t(ys[k]), src[k].count);
-                src[k].weight = 0.25f; // §5.1: α_merged = (α'_1 + ... + α'_4) / 4
-            }
-            starts[i] = uint32_t(row.size());
-            mergeLists(src, 4, plan.epsilon, plan.mean_depth, keep, row, dropped[j]);
-            longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
+        const int32_t xs[4] = {x0, x1, x0, x1};
+        const int32_t ys[4] = {y0, y0, y1, y1};
+        for (int k = 0; k < 4; ++k) {
+            src[k].data = prev.list(uint32_t(xs[k]), uint32_t(ys[k]), src[k].count);
+            src[k].weight = 0.25f; // §5.1: α_merged = (α'_1 + ... + α'_4) / 4
         }
-        starts[next.width] = uint32_t(row.size());
+        return 4u;
     });
-    sumRows(longest, dropped, next);
 }
 
 FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& grid, uint32_t index,
@@ -249,10 +262,6 @@ FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& gr
 void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelPlan& plan,
                 const LevelBorders& borders, raster::TaskPool& pool, FragmentLevel& out) {
     FOCAL_CHECK(grid.size >= 1 && grid.size <= kMaxApertureGrid);
-    out.rows.resize(out.height);
-    out.starts.assign(size_t(out.height) * (out.width + 1), 0);
-    std::vector<uint32_t> longest(out.height, 0);
-    std::vector<uint64_t> dropped(out.height, 0);
     const int32_t step = int32_t(out.dilation);
     const int32_t reach = int32_t(grid.size - 1) * step;
     const int32_t max_x = int32_t(box.width) - 1;
@@ -269,32 +278,20 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
             if (grid.at(a, b) > 0.0f)
                 taps.push_back(
                     {int32_t(a) * step - reach, int32_t(b) * step - reach, grid.at(a, b)});
-    const uint32_t level = out.index;
-    pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
-        std::vector<LayerFragment>& row = out.rows[j];
-        row.clear();
-        uint32_t* starts = out.starts.data() + size_t(j) * (out.width + 1);
-        auto keep = [&](float d) { return !plan.truncate || !truncatedAt(borders, level, d); };
-        ListRef src[kMaxMergeLists];
-        for (uint32_t i = 0; i < out.width; ++i) {
-            // Empty taps add nothing to the merge (x + w·0 = x), so only the others are passed,
-            // in grid order: the same bytes, less work where the view shows background.
-            uint32_t used = 0;
-            for (size_t k = 0; k < taps.size(); ++k) {
-                // Border cells clamped, as the stack's (Fig. 4).
-                const int32_t x = std::clamp(int32_t(i) + taps[k].a, 0, max_x);
-                const int32_t y = std::clamp(int32_t(j) + taps[k].b, 0, max_y);
-                src[used].data = box.list(uint32_t(x), uint32_t(y), src[used].count);
-                src[used].weight = taps[k].weight;
-                used += src[used].count > 0 ? 1 : 0;
-            }
-            starts[i] = uint32_t(row.size());
-            mergeLists(src, used, plan.epsilon, plan.mean_depth, keep, row, dropped[j]);
-            longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
+    mergeCells(plan, borders, out.index, pool, out, [&](uint32_t i, uint32_t j, ListRef* src) {
+        // Empty taps add nothing to the merge (x + w·0 = x), so only the others are passed, in
+        // grid order: the same bytes, less work where the view shows background.
+        uint32_t used = 0;
+        for (const Tap& tap : taps) {
+            // Border cells clamped, as the stack's (Fig. 4).
+            const int32_t x = std::clamp(int32_t(i) + tap.a, 0, max_x);
+            const int32_t y = std::clamp(int32_t(j) + tap.b, 0, max_y);
+            src[used].data = box.list(uint32_t(x), uint32_t(y), src[used].count);
+            src[used].weight = tap.weight;
+            used += src[used].count > 0 ? 1 : 0;
         }
-        starts[out.width] = uint32_t(row.size());
+        return used;
     });
-    sumRows(longest, dropped, out);
 }
 
 } // namespace dof

@@ -95,9 +95,9 @@ struct LevelPlan {
     float epsilon = 0.2f; // §5.1 depth threshold, relative: merge while d <= d0·(1 + ε)
     bool truncate = true; // §6.2: drop the depth intervals a level is never asked for
     // The depth a merged fragment carries: the mean of what it merged, weighted by visible
-    // opacity (true), or the paper's, the closest one's d0 (false). The mean keeps a level's
-    // copy of a slanted surface at the surface's depth at the cell centre, so every level puts
-    // it in the same segment of T.
+    // opacity (true), or the paper's, the closest one's d0 (false). The mean puts a level's
+    // copy of a surface at the depth the surface has on average over the cell, rather than at
+    // its nearest corner, and T then picks the level for that depth.
     bool mean_depth = true;
     uint32_t levels() const { return mip_steps + stack_steps; }
 };
@@ -161,7 +161,7 @@ inline bool truncatedAt(const LevelBorders& borders, uint32_t level, float depth
 // emit (Σ w α'c', Σ w α', depth) with depth d0 or, with mean_depth, the mean depth of what was
 // merged weighted by its visible opacity (in [d0, d0·(1 + ε)], so the output stays sorted);
 // repeat. Merged fragments with zero opacity are not emitted.
-// `keep(d0)` may drop a merged fragment (§6.2). Appends to `out`.
+// `keep(depth)` may drop a merged fragment (§6.2). Appends to `out`.
 struct ListRef {
     const LayerFragment* data = nullptr;
     uint32_t count = 0;
