@@ -41,6 +41,7 @@ struct Cursor {
     uint32_t count = 0;
     uint32_t next = 0;
     float weight = 0.0f;
+    bool pieces = false; // a filtered level's cell (shareInList)
 };
 
 constexpr float kOpaque = 1.0f - 1.0f / 1024.0f; // stop once the pixel is this opaque
@@ -366,6 +367,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                         cur.data = tlevel[side][s]->list(cx[k], cy[k], cur.count);
                         cur.next = 0;
                         cur.weight = w[k];
+                        cur.pieces = tlevel[side][s]->kind != LevelKind::Base;
                     }
                     cursor_count[side][s] = c;
                 }
@@ -417,7 +419,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                             for (; cur.next < cur.count && cur.data[cur.next].depth <= limit;
                                  ++cur.next) {
                                 const LayerFragment& f = cur.data[cur.next];
-                                const float tr = 1.0f - pa;
+                                const float tr = shareInList(f, cur.pieces, pa);
                                 pr += tr * f.r, pg += tr * f.g, pb += tr * f.b, pa += tr * f.a;
                             }
                             const float w = level_weight * cur.weight;

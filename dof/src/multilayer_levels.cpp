@@ -221,6 +221,7 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
         for (int k = 0; k < 4; ++k) {
             src[k].data = prev.list(uint32_t(xs[k]), uint32_t(ys[k]), src[k].count);
             src[k].weight = 0.25f; // §5.1: α_merged = (α'_1 + ... + α'_4) / 4
+            src[k].pieces = prev.kind != LevelKind::Base;
         }
         return 4u;
     });
@@ -288,6 +289,7 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
             const int32_t y = std::clamp(int32_t(j) + tap.b, 0, max_y);
             src[used].data = box.list(uint32_t(x), uint32_t(y), src[used].count);
             src[used].weight = tap.weight;
+            src[used].pieces = box.kind != LevelKind::Base;
             used += src[used].count > 0 ? 1 : 0;
         }
         return used;

@@ -154,9 +154,22 @@ inline bool truncatedAt(const LevelBorders& borders, uint32_t level, float depth
     return level >= 1 && depth > borders.z_near[level - 1] && depth < borders.z_far[level - 1];
 }
 
+// The share of fragment f that joins the blend of one list's fragments in a merge window whose
+// opacity so far is `pa` (§5.1, "within one source list"). A base list is one pixel's stack,
+// blended with the over operator: 1 - pa. A filtered cell's list holds pieces of the cell side
+// by side (a slanted surface's ε-depth bins, neighbouring leaves), not one behind the other:
+// they add up to full opacity, min(α, 1 - pa) / α. The over operator would count two halves of
+// the cell as 1 - (1 - 1/2)² = 3/4 of it and let the background show through opaque surfaces.
+inline float shareInList(const LayerFragment& f, bool pieces, float pa) {
+    if (!pieces)
+        return 1.0f - pa;
+    return f.a > 0.0f ? std::max(std::min(f.a, 1.0f - pa), 0.0f) / f.a : 0.0f;
+}
+
 // §5.1 merge of up to kMaxMergeLists depth-sorted lists into one sorted list, like merge
 // sort's combine: take the closest fragment d0 of all lists; from every list take its fragments
-// with d <= d0·(1 + ε) and blend them with the over operator (front to back, within one list); add
+// with d <= d0·(1 + ε) and blend them within the list (shareInList: the over operator for a base
+// list, additive for the pieces of a filtered cell); add
 // the lists' results weighted (the paper: 1/4 each for 2x2 lists, empty lists count as α' = 0);
 // emit (Σ w α'c', Σ w α', depth) with depth d0 or, with mean_depth, the mean depth of what was
 // merged weighted by its visible opacity (in [d0, d0·(1 + ε)], so the output stays sorted);
@@ -166,6 +179,7 @@ struct ListRef {
     const LayerFragment* data = nullptr;
     uint32_t count = 0;
     float weight = 0.0f;
+    bool pieces = false; // a filtered cell's list (shareInList)
 };
 template <class Keep>
 void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
@@ -226,12 +240,12 @@ void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool m
         LayerFragment merged;
         float depth_sum = 0.0f; // Σ w·(visible opacity)·depth, for the mean depth
         for (uint32_t k = 0; k < list_count; ++k) {
-            // Over operator within list k, front to back (§5.1, first case).
+            // Within list k, front to back (§5.1, first case).
             float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
             uint32_t c = cursor[k];
             const LayerFragment* l = lists[k].data;
             for (; c < lists[k].count && l[c].depth <= limit; ++c) {
-                const float t = 1.0f - pa;
+                const float t = shareInList(l[c], lists[k].pieces, pa);
                 pr += t * l[c].r, pg += t * l[c].g, pb += t * l[c].b, pa += t * l[c].a;
                 pd += t * l[c].a * l[c].depth;
             }
