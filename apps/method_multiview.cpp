@@ -33,6 +33,7 @@ struct MultiviewArgs {
     std::string thickness = "0.5";
     std::string cone = "on";
     std::string cone_misses = "on";
+    std::string cone_centre = "cell";
     std::string culling = "on";
     std::string precompute_paths = "on";
     std::string jitter = "none";
@@ -284,6 +285,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     s.thickness_px = parseThickness(a.thickness).value_or(INFINITY); // checked when parsed
     s.cone = a.cone == "on";
     s.cone_misses = a.cone_misses == "on";
+    s.cone_centre = a.cone_centre == "cell" ? dof::ConeCentre::Cell : dof::ConeCentre::Sample;
     s.culling = a.culling == "on";
     s.precompute_paths = a.precompute_paths == "on";
     s.jitter = a.jitter == "none"     ? dof::JitterMode::None
@@ -390,6 +392,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"thickness_px", a.thickness},
         {"cone", s.cone},
         {"cone_misses", s.cone_misses},
+        {"cone_centre", a.cone_centre},
         {"culling", s.culling},
         {"precompute_paths", s.precompute_paths},
         {"skip_unblurred", s.skip_unblurred},
@@ -492,6 +495,12 @@ MethodEntry makeMultiviewMethod() {
                        "its cone up there (off: the paper's rule, cones only at hits)")
             ->capture_default_str()
             ->check(CLI::IsMember({"on", "off"}));
+        cmd.add_option("--cone-centre", args->cone_centre,
+                       "multiview: with --cone on and --jitter none, centre each ray's cone on "
+                       "the centroid of its lens sample's Voronoi cell in the aperture (cell) or "
+                       "on the ray (sample: the paper)")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"cell", "sample"}));
         cmd.add_option("--culling", args->culling,
                        "multiview: early layer culling with N-buffers (Sec. 4.3)")
             ->capture_default_str()

@@ -108,7 +108,10 @@ struct Tracer {
     std::vector<RayPath> paths;
     std::vector<PathCell> cells;
     float lambda = 0.0f;
-    float r_max = 1.0f;           // bound of |v| over every lens position a ray may use
+    float r_max = 1.0f; // bound of |v| over every lens position a ray may use
+    // ConeCentre::Cell: per sample, its cone centre's image offset per unit C relative to the
+    // ray's (the cell offset, y flipped as lensRayImageOffset); empty: cones on the rays.
+    std::vector<glm::vec2> cone_offsets;
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     glm::vec3 background{0.0f};
 
@@ -521,7 +524,8 @@ struct MissCone {
 // texels among the footprint's taps, as for a hit). Off the image the cone is looked up at the
 // image border under OffscreenPolicy::Clamp (the border texels stand in for the unseen content,
 // as for a clamped hit) and not at all under Discard; the culling windows, clamped to the
-// image, then still hold every texel read. None when the cone sees nothing.
+// image, then still hold every texel read. None when the cone sees nothing. w: the cone centre's
+// image offset per unit C (the ray's, or its cell's with ConeCentre::Cell).
 std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w,
                                  bool shade, glm::vec3 eye, TileCounters& cnt) {
     const LayerSeg& seg = tr.segs[l];
@@ -637,7 +641,9 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
         ++cnt.rays;
         const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
         const glm::vec2 w(-ls.position.x, ls.position.y); // lensRayImageOffset per unit C
-        auto inside = [&](float t) {                      // (x, y) + o(t) lies in the image
+        // Where this ray's cones are centred, per unit C (ConeCentre).
+        const glm::vec2 wc = tr.cone_offsets.empty() ? w : w + tr.cone_offsets[k];
+        auto inside = [&](float t) { // (x, y) + o(t) lies in the image
             const glm::vec2 o = tr.offsetOf(w, t);
             return o.x >= -float(x) && o.y >= -float(y) && o.x < float(tr.width - x) &&
                    o.y < float(tr.height - y);
@@ -719,7 +725,7 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             // composited in depth order with the transparent plane.
             std::optional<MissCone> miss;
             if (!h.hit && seg.cone_px > 0.0f && s0 == seg.t0)
-                miss = missCone(tr, l, cx, cy, w, shade, shade_from, cnt);
+                miss = missCone(tr, l, cx, cy, wc, shade, shade_from, cnt);
             auto addMiss = [&] {
                 if (blend(miss->v1, miss->c1))
                     t_end = miss->t;
@@ -745,8 +751,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
                     const float ct = tr.cocOf(ht.t);
                     const glm::vec4 m =
                         s.cone && tr.lambda * std::fabs(ct) > 1.0f
-                            ? sampleCone(tr, tr.scratch->transparent_mips[l], cx + ct * w.x,
-                                         cy + ct * w.y, tr.lambda * std::fabs(ct))
+                            ? sampleCone(tr, tr.scratch->transparent_mips[l], cx + ct * wc.x,
+                                         cy + ct * wc.y, tr.lambda * std::fabs(ct))
                             : lt.transparent_color.load(lt.index(l, ht.texel));
                     glm::vec3 rgb(m);
                     const size_t ti = lt.index(l, ht.texel);
@@ -782,8 +788,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             if (cone_hit) {
                 // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha
                 // is its coverage v1, the mipmapped RGB / v1 its mean colour c1.
-                const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], cx + c_hit * w.x,
-                                               cy + c_hit * w.y, tr.lambda * std::fabs(c_hit));
+                const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], cx + c_hit * wc.x,
+                                               cy + c_hit * wc.y, tr.lambda * std::fabs(c_hit));
                 v1 = std::clamp(m.a, 0.0f, 1.0f);
                 c1 = v1 > 0.0f ? glm::vec3(m) / m.a : glm::vec3(0.0f);
             } else {
@@ -791,7 +797,7 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             }
             if (shade)
                 c1 = cone_hit
-                         ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * w.x, cy + c_hit * w.y,
+                         ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * wc.x, cy + c_hit * wc.y,
                                           0.5f * tr.lambda * std::fabs(c_hit), shade_from)
                          : shadeHit(tr, l, h.texel, h.t, shade_from);
             if (rec)
@@ -894,6 +900,35 @@ float meanNeighbourDistance(const LensSampleSet& samples) {
     return float(sum / double(n));
 }
 
+std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fine_per_sample) {
+    const uint32_t n = samples.size();
+    std::vector<glm::vec2> offsets(n, glm::vec2(0.0f));
+    const uint64_t wanted = uint64_t(n) * std::max(fine_per_sample, 1u);
+    const uint32_t fine_count = uint32_t(std::min<uint64_t>(wanted, 65536));
+    raster::Result<LensSampleSet> fine =
+        LensSampleSet::create(samples.shape(), LensPattern::Hammersley, fine_count, 0);
+    if (!fine.ok() || n == 0)
+        return offsets; // the shape built the main set, so it builds this one too
+    std::vector<glm::dvec2> sum(n, glm::dvec2(0.0));
+    std::vector<double> weight(n, 0.0);
+    for (const LensSample& q : fine->samples()) {
+        uint32_t best = 0;
+        float best_d2 = INFINITY;
+        for (uint32_t i = 0; i < n; ++i) {
+            const glm::vec2 d = q.position - samples.sample(i).position;
+            const float d2 = glm::dot(d, d);
+            if (d2 < best_d2)
+                best_d2 = d2, best = i;
+        }
+        sum[best] += double(q.weight) * glm::dvec2(q.position);
+        weight[best] += double(q.weight);
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        if (weight[i] > 0.0)
+            offsets[i] = glm::vec2(sum[i] / weight[i]) - samples.sample(i).position;
+    return offsets;
+}
+
 raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& lens,
                                                              const DepthRange& range,
                                                              const MultiviewSettings& settings,
@@ -980,6 +1015,15 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     float r_max = 0.0f;
     for (const LensSample& ls : samples.samples())
         r_max = std::max(r_max, glm::length(ls.position));
+    if (settings.cone && settings.cone_centre == ConeCentre::Cell &&
+        settings.jitter == JitterMode::None) {
+        const std::vector<glm::vec2> cells = lensCellOffsets(samples);
+        for (uint32_t k = 0; k < samples.size(); ++k) {
+            tr.cone_offsets.push_back(glm::vec2(-cells[k].x, cells[k].y));
+            // The culling windows and mip levels bound every position a cone is centred on.
+            r_max = std::max(r_max, glm::length(samples.sample(k).position + cells[k]));
+        }
+    }
     if (settings.jitter == JitterMode::Halton)
         for (const LensSample& ls : settings.sequence_2n->samples())
             r_max = std::max(r_max, glm::length(ls.position));

@@ -94,6 +94,7 @@ public:
                                                 uint32_t count, uint32_t seed);
 
     uint32_t size() const { return uint32_t(samples_.size()); }
+    const ApertureShape& shape() const { return sampler_.shape(); }
     LensPattern pattern() const { return pattern_; }
     uint32_t seed() const { return seed_; }
     // The shared sample `index` (< size()).

@@ -61,6 +61,17 @@ enum class OffscreenPolicy : uint8_t {
              // (docs/benchmarks.md)
 };
 
+// Where a ray's cone (§4.4) is centred. A cone stands for the part of the aperture closest to
+// its lens sample, its Voronoi cell. Sample centres it on the ray (the paper): the cones of the
+// outer samples then reach past the aperture's rim by half a sample spacing, and every defocused
+// highlight's disc gets a soft, too wide rim. Cell centres it on the cell's centroid
+// (lensCellOffsets), which lies inward of an outer sample. Used with JitterMode::None: the
+// other modes move the samples per pixel, so their cones stay on the ray.
+enum class ConeCentre : uint8_t {
+    Sample,
+    Cell,
+};
+
 // How a cone hit (§4.4) is shaded when hits are re-shaded per ray (§5). The paper mipmaps the
 // G-buffer; shading a filtered G-buffer texel is not the filtered shading, so we instead shade
 // level-0 texels of the cone's footprint and average them.
@@ -128,6 +139,7 @@ struct MultiviewSettings {
     // paper evaluates the cone only at an impact point, so rays that pass beside a small or thin
     // object never see it and the gaps between lens samples stay (false: the paper's rule).
     bool cone_misses = true;
+    ConeCentre cone_centre = ConeCentre::Cell; // with cone and JitterMode::None
     JitterMode jitter = JitterMode::None;
     uint32_t seed = 0; // jitter key
     OffscreenPolicy offscreen = OffscreenPolicy::Clamp;
@@ -207,6 +219,13 @@ raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& len
 
 // Mean distance from each sample to its nearest neighbour in lens units: the lambda of §4.4.
 float meanNeighbourDistance(const LensSampleSet& samples);
+
+// For each lens sample, the centroid of its Voronoi cell within the aperture minus the sample,
+// in lens units (ConeCentre::Cell). The cell is measured on a denser set of the same pattern
+// family and aperture, `fine_per_sample` points per sample (at most 65536 in all): each point
+// goes to its nearest sample (ties: the lower index) and the centroid is the weighted mean of a
+// sample's points (a sample without points keeps offset 0).
+std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fine_per_sample = 64);
 
 // The view-dependent shading context (§5): the scene whose lights shade each hit with the
 // rasterizer's model (raster::SurfaceShader), plus MultiviewSettings::env_map reflections.
