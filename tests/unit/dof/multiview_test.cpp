@@ -209,6 +209,52 @@ TEST(Multiview, LensCellOffsetsPartitionTheAperture) {
     }
 }
 
+TEST(Multiview, NearestSampleQueriesMatchAScanOfEverySample) {
+    // meanNeighbourDistance and lensCellOffsets find nearest samples on a grid (N may be in the
+    // millions); they must give the bits a scan of all samples gives (ties: the lower index).
+    dof::ApertureShape hexagon;
+    hexagon.kind = dof::ApertureKind::Polygon;
+    hexagon.blades = 6;
+    for (const dof::LensPattern pattern :
+         {dof::LensPattern::Hammersley, dof::LensPattern::Halton, dof::LensPattern::Poisson}) {
+        for (const dof::ApertureShape& shape : {dof::ApertureShape{}, hexagon}) {
+            const dof::LensSampleSet samples = makeSamples(300, shape, pattern, 3);
+            const uint32_t n = samples.size();
+            auto scan = [&](glm::vec2 q, uint32_t skip) {
+                uint32_t best = n;
+                float best_d2 = INFINITY;
+                for (uint32_t i = 0; i < n; ++i) {
+                    const glm::vec2 d = q - samples.sample(i).position;
+                    if (i != skip && glm::dot(d, d) < best_d2)
+                        best_d2 = glm::dot(d, d), best = i;
+                }
+                return best;
+            };
+            double sum = 0.0;
+            for (uint32_t i = 0; i < n; ++i)
+                sum += double(
+                    glm::length(samples.sample(i).position -
+                                samples.sample(scan(samples.sample(i).position, i)).position));
+            EXPECT_EQ(dof::meanNeighbourDistance(samples), float(sum / double(n)));
+            const dof::LensSampleSet fine = makeSamples(64 * n > 65536 ? 65536 : 64 * n, shape);
+            std::vector<glm::dvec2> centroid(n, glm::dvec2(0.0));
+            std::vector<double> weight(n, 0.0);
+            for (const dof::LensSample& q : fine.samples()) {
+                const uint32_t k = scan(q.position, n);
+                centroid[k] += double(q.weight) * glm::dvec2(q.position);
+                weight[k] += double(q.weight);
+            }
+            const std::vector<glm::vec2> off = dof::lensCellOffsets(samples);
+            for (uint32_t k = 0; k < n; ++k) {
+                const glm::vec2 want = weight[k] > 0.0 ? glm::vec2(centroid[k] / weight[k]) -
+                                                             samples.sample(k).position
+                                                       : glm::vec2(0.0f);
+                ASSERT_EQ(off[k], want) << "sample " << k;
+            }
+        }
+    }
+}
+
 TEST(Multiview, CellCentredConesKeepTheHighlightsRim) {
     // The small square of BlurRadiusMatchesTheLens (C = 8 px) with 64 lens samples: cones on
     // the rays (the paper) let the outer samples' cones spill past the disc's rim; centred on
