@@ -392,7 +392,11 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"thickness_px", a.thickness},
         {"cone", s.cone},
         {"cone_misses", s.cone_misses},
-        {"cone_centre", a.cone_centre},
+        // What the cones used: cells only with cones on and the shared sample set.
+        {"cone_centre",
+         s.cone && s.jitter == dof::JitterMode::None && s.cone_centre == dof::ConeCentre::Cell
+             ? "cell"
+             : "sample"},
         {"culling", s.culling},
         {"precompute_paths", s.precompute_paths},
         {"skip_unblurred", s.skip_unblurred},

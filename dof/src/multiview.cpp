@@ -110,7 +110,7 @@ struct Tracer {
     float lambda = 0.0f;
     float r_max = 1.0f; // bound of |v| over every lens position a ray may use
     // ConeCentre::Cell: per sample, its cone centre's image offset per unit C relative to the
-    // ray's (the cell offset, y flipped as lensRayImageOffset); empty: cones on the rays.
+    // ray's (the cell offset with x negated, as lensRayImageOffset); empty: cones on the rays.
     std::vector<glm::vec2> cone_offsets;
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     glm::vec3 background{0.0f};
@@ -980,6 +980,10 @@ std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fi
     std::vector<glm::vec2> offsets(n, glm::vec2(0.0f));
     const uint64_t wanted = uint64_t(n) * std::max(fine_per_sample, 1u);
     const uint32_t fine_count = uint32_t(std::min<uint64_t>(wanted, 65536));
+    // Under 16 points a cell, the centroids are noise (at 64k samples Hammersley's denser set is
+    // the set itself); such sets have cones under a pixel wide anyway: keep them on the rays.
+    if (uint64_t(fine_count) < 16 * uint64_t(n))
+        return offsets;
     raster::Result<LensSampleSet> fine =
         LensSampleSet::create(samples.shape(), LensPattern::Hammersley, fine_count, 0);
     if (!fine.ok() || n == 0)
@@ -1090,7 +1094,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         const std::vector<glm::vec2> cells = lensCellOffsets(samples);
         for (uint32_t k = 0; k < samples.size(); ++k) {
             tr.cone_offsets.push_back(glm::vec2(-cells[k].x, cells[k].y));
-            // The culling windows and mip levels bound every position a cone is centred on.
+            // The culling windows (and N-buffer levels) bound every cone centre as every ray.
             r_max = std::max(r_max, glm::length(samples.sample(k).position + cells[k]));
         }
     }

@@ -160,6 +160,8 @@ inline bool truncatedAt(const LevelBorders& borders, uint32_t level, float depth
 // by side (a slanted surface's ε-depth bins, neighbouring leaves), not one behind the other:
 // they add up to full opacity, min(α, 1 - pa) / α. The over operator would count two halves of
 // the cell as 1 - (1 - 1/2)² = 3/4 of it and let the background show through opaque surfaces.
+// The cost: translucent surfaces stacked within ε of each other over the same part of a cell
+// (two α = 0.5 panes) add up too (1 instead of 0.75) in the filtered levels.
 inline float shareInList(const LayerFragment& f, bool pieces, float pa) {
     if (!pieces)
         return 1.0f - pa;

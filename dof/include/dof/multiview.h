@@ -3,7 +3,8 @@
 // through the lens centre (§4.1-4.2; or render callbacks that produce them), the thin lens and a
 // lens sample set; traces N lens rays per pixel through the layers' height fields (§4.3, Eq. 2-3)
 // with N-buffer culling (§4.3), approximate cone tracing (§4.4; also for rays that miss a
-// layer, MultiviewSettings::cone_misses), optional jittered lens sampling (§4.5; the shared set
+// layer, MultiviewSettings::cone_misses; cones centred on their samples' Voronoi cells,
+// MultiviewSettings::cone_centre), optional jittered lens sampling (§4.5; the shared set
 // is the default) and optional view-dependent shading per ray (§5). Produces linear RGBA owned
 // by the caller; scratch (N-buffers, mipmaps) lives in the MultiviewScratch the caller may keep
 // between frames.
@@ -221,10 +222,11 @@ raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& len
 float meanNeighbourDistance(const LensSampleSet& samples);
 
 // For each lens sample, the centroid of its Voronoi cell within the aperture minus the sample,
-// in lens units (ConeCentre::Cell). The cell is measured on a denser set of the same pattern
-// family and aperture, `fine_per_sample` points per sample (at most 65536 in all): each point
-// goes to its nearest sample (ties: the lower index) and the centroid is the weighted mean of a
-// sample's points (a sample without points keeps offset 0).
+// in lens units (ConeCentre::Cell). The cell is measured on a Hammersley set (seed 0) on the
+// same aperture, `fine_per_sample` points per sample and at most 65536 in all: each point goes
+// to its nearest sample (ties: the lower index) and the centroid is the weighted mean of a
+// sample's points (a sample without points keeps offset 0). All offsets are 0 when that leaves
+// fewer than 16 points a sample (more than 4096 samples by default).
 std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fine_per_sample = 64);
 
 // The view-dependent shading context (§5): the scene whose lights shade each hit with the

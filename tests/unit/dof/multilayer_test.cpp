@@ -299,7 +299,8 @@ TEST(Multilayer, SlantedOpaqueSurfaceHidesTheBackground) {
     // A black plane slanted from depth 40 to 70 in front of the focal plane (C = -18 ... -5 px)
     // covers the view and more, in front of a white background: every lens ray meets it, so
     // the image is black. With ε = 0.05 the aperture levels' cells cut the plane into depth
-    // bins that lie side by side; blended with the over operator within a cell's list, two
+    // bins that lie side by side (the box levels' cells are too small to split here, so only
+    // aperture levels are run); blended with the over operator within a cell's list, two
     // halves of a cell would cover 3/4 of it (measured: 3.2 % of white on average, 9.4 % at
     // most). What still shows (0.8 %, 3.2 % at most) is where a level's copy of the plane
     // straddles a border of T, and the part beyond the border is not read there.
@@ -313,9 +314,9 @@ TEST(Multilayer, SlantedOpaqueSurfaceHidesTheBackground) {
              {80.0f, 60.0f, -70.0f},
              {-40.0f, 60.0f, -40.0f}},
             {0, 1, 2, 0, 2, 3}, black);
-    for (dof::LevelFilter filter : {dof::LevelFilter::Box, dof::LevelFilter::Aperture}) {
+    {
         dof::MultilayerSettings settings;
-        settings.filter = filter;
+        settings.filter = dof::LevelFilter::Aperture;
         settings.truncate = false;
         settings.epsilon = 0.05f;
         const MlRun ml =
@@ -328,9 +329,7 @@ TEST(Multilayer, SlantedOpaqueSurfaceHidesTheBackground) {
                     l.list(i, j, count);
                     split_cells += count > 1 ? 1 : 0;
                 }
-        if (filter == dof::LevelFilter::Aperture) {
-            EXPECT_GT(split_cells, 0u);
-        }
+        EXPECT_GT(split_cells, 0u);
         float brightest = 0.0f;
         double mean = 0.0;
         for (uint32_t y = 0; y < kH; ++y)
@@ -338,9 +337,8 @@ TEST(Multilayer, SlantedOpaqueSurfaceHidesTheBackground) {
                 brightest = std::max(brightest, channel(ml.image, x, y, 0));
                 mean += double(channel(ml.image, x, y, 0)) / double(kW * kH);
             }
-        const char* name = filter == dof::LevelFilter::Box ? "box" : "aperture";
-        EXPECT_LT(mean, 0.012) << name;
-        EXPECT_LT(brightest, 0.05f) << name;
+        EXPECT_LT(mean, 0.012);
+        EXPECT_LT(brightest, 0.05f);
     }
 }
 
@@ -559,7 +557,7 @@ TEST(Multilayer, TransparentPaneTintsWhatIsBehindIt) {
     const raster::Frame wall = render(checkerWall(kFocus), view);
     dof::MultilayerSettings settings;
     settings.color_format = raster::ColorFormat::Float32;
-    settings.epsilon = 0.2f;
+    settings.epsilon = 0.001f;
     const MlRun ml = runMultilayer(scene, view, dof::makeThinLens(view, 1.0f, kFocus), settings);
     for (uint32_t y = 4; y < kH; y += 9)
         for (uint32_t x = 4; x < kW; x += 9) {

@@ -176,9 +176,10 @@ TEST(Multiview, ConesOfMissedRaysKeepASmallLightsEnergy) {
 }
 
 TEST(Multiview, LensCellOffsetsPartitionTheAperture) {
-    // The cells partition the aperture, so their centroids (sample + offset) average to its
-    // centre with the samples' weights; an outer sample's cell lies inward of it; no offset
-    // reaches a neighbour.
+    // An outer sample's cell lies inward of it (this catches zero or sign-flipped offsets); the
+    // centroids (sample + offset) of these near-equal-area cells average to the aperture's
+    // centre (exactly so only with area weights); every offset is shorter than the mean
+    // neighbour distance.
     dof::ApertureShape hexagon;
     hexagon.kind = dof::ApertureKind::Polygon;
     hexagon.blades = 6;
