@@ -392,11 +392,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         {"thickness_px", a.thickness},
         {"cone", s.cone},
         {"cone_misses", s.cone_misses},
-        // What the cones used: cells only with cones on and the shared sample set.
-        {"cone_centre",
-         s.cone && s.jitter == dof::JitterMode::None && s.cone_centre == dof::ConeCentre::Cell
-             ? "cell"
-             : "sample"},
+        {"cone_centre", a.cone_centre},
         {"culling", s.culling},
         {"precompute_paths", s.precompute_paths},
         {"skip_unblurred", s.skip_unblurred},
@@ -420,6 +416,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                   {"d_near", st.d_near},
                   {"d_far", st.d_far},
                   {"lambda", st.lambda},
+                  {"cone_centre", st.cones_on_cells ? "cell" : "sample"},
                   {"nbuffer_levels", st.nbuffer_levels},
                   {"mip_levels", st.mip_levels},
                   {"rays", st.rays},

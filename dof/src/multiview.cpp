@@ -918,11 +918,12 @@ public:
         float best_d2 = INFINITY;
         const int64_t cx = axisCell(q.x - lo_.x), cy = axisCell(q.y - lo_.y);
         for (int64_t r = 0; r <= int64_t(side_); ++r) {
-            for (int64_t y = cy - r; y <= cy + r; ++y)
-                for (int64_t x = cx - r; x <= cx + r; ++x) {
-                    if (std::max(std::llabs(x - cx), std::llabs(y - cy)) != r || x < 0 || y < 0 ||
-                        x >= int64_t(side_) || y >= int64_t(side_))
-                        continue; // only the ring at Chebyshev distance r, inside the grid
+            // The ring at Chebyshev distance r: full top and bottom rows, the two side columns.
+            for (int64_t y = cy - r; y <= cy + r; ++y) {
+                const int64_t step = (y == cy - r || y == cy + r) ? 1 : std::max<int64_t>(2 * r, 1);
+                for (int64_t x = cx - r; x <= cx + r; x += step) {
+                    if (x < 0 || y < 0 || x >= int64_t(side_) || y >= int64_t(side_))
+                        continue;
                     const size_t c = size_t(y) * side_ + size_t(x);
                     for (uint32_t k = start_[c]; k < start_[c + 1]; ++k) {
                         const uint32_t i = index_[k];
@@ -934,6 +935,7 @@ public:
                             best_d2 = d2, best = i;
                     }
                 }
+            }
             // Every sample not yet seen lies at least r cells from q's cell, so at least
             // r * cell from q (q's own cell is clamped into the grid, which only shortens it).
             if (best < n && std::sqrt(best_d2) < float(r) * cell_ * 0.999f)
@@ -982,11 +984,11 @@ std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fi
     const uint32_t fine_count = uint32_t(std::min<uint64_t>(wanted, 65536));
     // Under 16 points a cell, the centroids are noise (at 64k samples Hammersley's denser set is
     // the set itself); such sets have cones under a pixel wide anyway: keep them on the rays.
-    if (uint64_t(fine_count) < 16 * uint64_t(n))
+    if (n == 0 || uint64_t(fine_count) < 16 * uint64_t(n))
         return offsets;
     raster::Result<LensSampleSet> fine =
         LensSampleSet::create(samples.shape(), LensPattern::Hammersley, fine_count, 0);
-    if (!fine.ok() || n == 0)
+    if (!fine.ok())
         return offsets; // the shape built the main set, so it builds this one too
     const SampleGrid grid(samples);
     std::vector<glm::dvec2> sum(n, glm::dvec2(0.0));
@@ -1091,6 +1093,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         r_max = std::max(r_max, glm::length(ls.position));
     if (settings.cone && settings.cone_centre == ConeCentre::Cell &&
         settings.jitter == JitterMode::None) {
+        stats.cones_on_cells = true;
         const std::vector<glm::vec2> cells = lensCellOffsets(samples);
         for (uint32_t k = 0; k < samples.size(); ++k) {
             tr.cone_offsets.push_back(glm::vec2(-cells[k].x, cells[k].y));

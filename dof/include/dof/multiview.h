@@ -170,6 +170,7 @@ struct MultiviewStats {
     bool budget_limited = false;       // the spacing needed more than raster::kMaxLayers layers
     float d_near = 0.0f, d_far = 0.0f; // visible depth range (§4.1)
     float lambda = 0.0f;         // mean nearest-neighbour distance of the lens samples (§4.4)
+    bool cones_on_cells = false; // the cones were centred on their samples' cells (ConeCentre)
     uint32_t nbuffer_levels = 0; // most levels any layer needed
     uint32_t mip_levels = 0;
     uint64_t rays = 0;               // lens rays traced (pixels x N)
