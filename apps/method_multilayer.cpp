@@ -22,6 +22,7 @@ struct MultilayerArgs {
     dof::MultilayerSettings settings;
     std::string stack_levels = "auto";
     std::string truncate = "on";
+    std::string skip_hidden = "on";
     std::string blend = "additive";
     std::string filter = "aperture";
     std::string merge_depth = "mean";
@@ -74,6 +75,7 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
         settings.stack_levels = int32_t(v);
     }
     settings.truncate = args.truncate == "on";
+    settings.skip_hidden = args.skip_hidden == "on";
     settings.blend = args.blend == "additive" ? dof::LayerBlend::Additive : dof::LayerBlend::Over;
     settings.filter =
         args.filter == "aperture" ? dof::LevelFilter::Aperture : dof::LevelFilter::Box;
@@ -135,6 +137,7 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
         {"collect", st.ms_collect}, {"filter", st.ms_filter}, {"accumulate", st.ms_accumulate}};
     out.params = {
         {"fragments_per_pixel", settings.fragments_per_pixel},
+        {"skip_hidden", settings.skip_hidden},
         {"mip_levels", st.mip_levels},
         {"stack_levels", st.stack_levels},
         {"stack_levels_option", args.stack_levels},
@@ -185,6 +188,7 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     }
     out.counts = {{"fragments_collected", st.fragments_collected},
                   {"fragments_rejected_early", st.fragments_rejected},
+                  {"fragments_hidden", st.fragments_hidden},
                   {"fragments_kept", st.fragments_kept},
                   {"max_list_length", st.max_list_length},
                   {"node_pool_grew", st.node_pool_grew},
@@ -226,6 +230,12 @@ MethodEntry makeMultilayerMethod() {
                         "multilayer: depth threshold for merging fragments, relative to depth "
                         "(§5.1)")
             ->default_val(0.2f);
+        render
+            .add_option("--skip-hidden", args->skip_hidden,
+                        "multilayer: the closest N skip fragments within --epsilon behind an "
+                        "opaque fragment of their pixel (off: the paper's closest N of all, §4)")
+            ->check(CLI::IsMember({"on", "off"}))
+            ->default_val("on");
         render
             .add_option("--truncate", args->truncate, "multilayer: fragment list truncation (§6.2)")
             ->check(CLI::IsMember({"on", "off"}))

@@ -26,6 +26,8 @@ struct Renderer::State {
     std::vector<uint32_t> list_head;
     std::vector<std::vector<FragmentNode>> list_pools;
     std::vector<std::vector<FragmentNode>> sort_scratch;
+    std::vector<std::vector<FragmentNode>>
+        list_kept; // per tile: its lists as the resolve keeps them
     // ListSink early rejection: per worker, the k nearest depths of each pixel of its tile.
     std::vector<std::vector<float>> list_nearest;
 };
@@ -288,10 +290,16 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     const size_t pixels = size_t(view.width) * view.height;
     st.list_head.assign(pixels, kNoNode);
     st.list_pools.resize(tiles);
-    const uint32_t early_k =
-        desc.early_reject && desc.max_per_pixel > 0 && desc.max_per_pixel <= kMaxEarlyRejectCap
-            ? desc.max_per_pixel
-            : 0;
+    if (!(desc.hidden_epsilon >= 0.0f) || !std::isfinite(desc.hidden_epsilon))
+        return Status::error("fragment list hidden epsilon must be finite and >= 0");
+    const bool early =
+        desc.early_reject && desc.max_per_pixel > 0 && desc.max_per_pixel <= kMaxEarlyRejectCap;
+    const float hidden_scale = desc.hidden_epsilon > 0.0f ? 1.0f + desc.hidden_epsilon : 0.0f;
+    // Keys per pixel for early rejection: the N nearest depths, or with hidden fragments more
+    // distances than N (nearer ones may turn out hidden; see ListSink).
+    const uint32_t early_k = !early                ? 0
+                             : hidden_scale > 0.0f ? kMaxEarlyRejectCap
+                                                   : desc.max_per_pixel;
     if (st.sort_scratch.size() < pool_.workerCount())
         st.sort_scratch.resize(pool_.workerCount());
     st.list_nearest.resize(pool_.workerCount());
@@ -308,6 +316,9 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                            INFINITY);
             sink.nearest = nearest.data();
             sink.k = early_k;
+            sink.cap = desc.max_per_pixel;
+            sink.hidden_scale = hidden_scale;
+            sink.view = &view;
             sink.frame_width = view.width;
             sink.tile_x0 = r.x0, sink.tile_y0 = r.y0, sink.tile_size = st.ctx.grid.tile_size;
         }
@@ -337,55 +348,79 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         out.node_capacity_used = uint32_t(std::min<uint64_t>(collected, UINT32_MAX));
     }
 
-    // Resolve (Selgrad et al. §4): counts, prefix sum, then sort each list into its slot.
+    // Resolve (Selgrad et al. §4): sort each list and pick what it keeps into its tile's
+    // scratch, prefix sum over the counts, then copy every tile's lists into their slots.
     t0 = std::chrono::steady_clock::now();
     const uint32_t cap = desc.max_per_pixel == 0 ? UINT32_MAX : desc.max_per_pixel;
     out.offsets.assign(pixels + 1, 0);
     out.list_length.assign(pixels, 0);
+    st.list_kept.resize(tiles);
     std::vector<uint32_t> longest(tiles, 0);
-    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
-        const TileRect r = tileRect(st.ctx.grid, tile);
-        const std::vector<FragmentNode>& nodes = st.list_pools[tile];
-        for (uint32_t y = r.y0; y < r.y1; ++y)
-            for (uint32_t x = r.x0; x < r.x1; ++x) {
-                const size_t p = size_t(y) * view.width + x;
-                uint32_t n = 0;
-                for (uint32_t i = st.list_head[p]; i != kNoNode; i = nodes[i].next)
-                    ++n;
-                longest[tile] = std::max(longest[tile], n);
-                out.list_length[p] = n;
-                out.offsets[p + 1] = std::min(n, cap);
-            }
-    });
-    for (size_t p = 0; p < pixels; ++p)
-        out.offsets[p + 1] += out.offsets[p];
-    for (uint32_t l : longest)
-        out.max_list_length = std::max(out.max_list_length, l);
-    const uint32_t kept = out.offsets[pixels];
-    out.fragments_kept = kept;
-    out.color.resize(desc.color_format, kept, glm::vec4(0.0f));
-    out.depth.resize(desc.depth_format, kept, kept > 0 ? 1 : 0);
-    out.primitive.assign(kept, 0);
+    std::vector<uint64_t> hidden(tiles, 0);
     pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
         const TileRect r = tileRect(st.ctx.grid, tile);
         const std::vector<FragmentNode>& nodes = st.list_pools[tile];
         std::vector<FragmentNode>& list = st.sort_scratch[worker];
+        std::vector<FragmentNode>& kept = st.list_kept[tile];
+        kept.clear();
         for (uint32_t y = r.y0; y < r.y1; ++y)
             for (uint32_t x = r.x0; x < r.x1; ++x) {
                 const size_t p = size_t(y) * view.width + x;
                 list.clear();
                 for (uint32_t i = st.list_head[p]; i != kNoNode; i = nodes[i].next)
                     list.push_back(nodes[i]);
+                const uint32_t n = uint32_t(list.size());
+                longest[tile] = std::max(longest[tile], n);
+                out.list_length[p] = n;
                 // Total order: depth, then primitive id (never arrival order).
                 std::sort(list.begin(), list.end(),
                           [](const FragmentNode& a, const FragmentNode& b) {
                               return a.z < b.z || (a.z == b.z && a.primitive_id < b.primitive_id);
                           });
-                const uint32_t first = out.offsets[p], count = out.offsets[p + 1] - first;
-                for (uint32_t k = 0; k < count; ++k) {
-                    out.color.store(first + k, list[k].color);
-                    out.depth.store(first + k, list[k].z);
-                    out.primitive[first + k] = list[k].primitive_id;
+                // The closest `cap`, skipping those within the factor hidden_scale behind the
+                // last kept opaque fragment.
+                uint32_t count = 0;
+                float opaque = -1.0f; // distance of the last kept opaque fragment
+                for (const FragmentNode& f : list) {
+                    if (count == cap)
+                        break;
+                    if (hidden_scale > 0.0f) {
+                        const float d = distanceFromDepth(view, f.z);
+                        if (opaque >= 0.0f && d <= opaque * hidden_scale) {
+                            ++hidden[tile];
+                            continue;
+                        }
+                        if (f.color.a >= 1.0f)
+                            opaque = d;
+                    }
+                    kept.push_back(f);
+                    ++count;
+                }
+                out.offsets[p + 1] = count;
+            }
+    });
+    for (size_t p = 0; p < pixels; ++p)
+        out.offsets[p + 1] += out.offsets[p];
+    for (uint32_t t = 0; t < tiles; ++t) {
+        out.max_list_length = std::max(out.max_list_length, longest[t]);
+        out.fragments_hidden += hidden[t];
+    }
+    const uint32_t total = out.offsets[pixels];
+    out.fragments_kept = total;
+    out.color.resize(desc.color_format, total, glm::vec4(0.0f));
+    out.depth.resize(desc.depth_format, total, total > 0 ? 1 : 0);
+    out.primitive.assign(total, 0);
+    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
+        const TileRect r = tileRect(st.ctx.grid, tile);
+        const std::vector<FragmentNode>& kept = st.list_kept[tile];
+        size_t k = 0; // the tile's pixels in the order they were picked
+        for (uint32_t y = r.y0; y < r.y1; ++y)
+            for (uint32_t x = r.x0; x < r.x1; ++x) {
+                const size_t p = size_t(y) * view.width + x;
+                for (uint32_t i = out.offsets[p]; i < out.offsets[p + 1]; ++i, ++k) {
+                    out.color.store(i, kept[k].color);
+                    out.depth.store(i, kept[k].z);
+                    out.primitive[i] = kept[k].primitive_id;
                 }
             }
     });

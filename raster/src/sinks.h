@@ -8,6 +8,7 @@
 #include "geometry.h"
 #include "tile_raster.h"
 
+#include <raster/camera.h>
 #include <raster/fragment_lists.h>
 #include <raster/frame.h>
 #include <raster/layered_target.h>
@@ -122,17 +123,28 @@ constexpr uint32_t kNoNode = 0xffffffffu;
 // Collects into the tile's own node pool (appending at the list head, as an atomic exchange on
 // the GPU does); pools are concatenated in tile order afterwards, so node order is deterministic.
 //
-// Early rejection (when `nearest` is set, for a cap of k fragments per pixel): the sink keeps the
-// k smallest depths written to each pixel so far and rejects, before shading, a fragment beyond
-// the k-th. That is exact whatever the arrival order: k fragments strictly nearer sort before it,
-// so the resolve would drop it anyway.
+// Early rejection (when `nearest` is set, for a cap of N fragments per pixel): the sink keeps the
+// k smallest keys written to each pixel so far and rejects, before shading, a fragment that the
+// resolve would drop whatever arrives later.
+//  - Without hidden fragments (FragmentListDesc::hidden_epsilon = 0): k = N keys, the stored
+//    depths; a fragment beyond the N-th is rejected. Exact whatever the arrival order: N
+//    fragments strictly nearer sort before it.
+//  - With them (`hidden_scale` = 1 + ε > 1): k >= N keys, the view distances; a fragment is
+//    rejected when N of the nearer keys are spaced by more than the factor 1 + ε. Each of those N
+//    is either kept by the resolve or hidden by a kept opaque fragment in front of it, and no
+//    kept fragment hides two of them (its window d_o..d_o(1 + ε) holds at most one), so N kept
+//    fragments sort before it. The k nearest are a subset of the pixel's fragments, so the test
+//    only ever under-counts: it may keep a fragment the resolve drops, never the reverse.
 struct ListSink {
     std::vector<uint32_t>& head;     // per pixel: first node (tile-local index) or kNoNode
     std::vector<FragmentNode>& pool; // this tile's nodes
-    // Early rejection: per pixel of the tile (row-major, tile_size wide), k ascending depths
-    // (+inf = none yet); null when off.
+    // Per pixel of the tile (row-major, tile_size wide), k ascending keys (+inf = none yet);
+    // null when early rejection is off.
     float* nearest = nullptr;
     uint32_t k = 0;
+    uint32_t cap = 0;           // N
+    float hidden_scale = 0.0f;  // 1 + ε with hidden fragments, else 0 (the keys are depths)
+    const View* view = nullptr; // for the distances of the keys with hidden fragments
     uint32_t frame_width = 0, tile_x0 = 0, tile_y0 = 0, tile_size = 0;
     static constexpr bool wants_gbuffer = false;
 
@@ -140,19 +152,37 @@ struct ListSink {
         const size_t x = pixel % frame_width, y = pixel / frame_width;
         return nearest + ((y - tile_y0) * tile_size + (x - tile_x0)) * k;
     }
+    float keyOf(float z) const { return hidden_scale > 0.0f ? distanceFromDepth(*view, z) : z; }
     void beginTriangle(const SetupTri&, bool) {}
     bool test(size_t pixel, float z, float) const {
-        return !nearest || !(z > nearestOf(pixel)[k - 1]);
+        if (!nearest)
+            return true;
+        const float* keys = nearestOf(pixel);
+        if (!(hidden_scale > 0.0f))
+            return !(z > keys[k - 1]);
+        const float d = keyOf(z);
+        uint32_t spaced = 0;
+        float last = 0.0f;
+        for (uint32_t i = 0; i < k && keys[i] < d; ++i)
+            if (spaced == 0 || keys[i] > last * hidden_scale) {
+                last = keys[i];
+                if (++spaced == cap)
+                    return false;
+            }
+        return true;
     }
     void write(size_t pixel, const Fragment& f) {
         pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
         head[pixel] = uint32_t(pool.size() - 1);
-        if (nearest) { // insert f.z into the pixel's ascending k depths, dropping the largest
+        if (nearest) { // insert the key into the pixel's ascending k keys, dropping the largest
             float* d = nearestOf(pixel);
-            uint32_t i = k - 1;
-            for (; i > 0 && d[i - 1] > f.z; --i)
-                d[i] = d[i - 1];
-            d[i] = f.z;
+            const float key = keyOf(f.z);
+            if (key < d[k - 1]) { // else not among the k nearest
+                uint32_t i = k - 1;
+                for (; i > 0 && d[i - 1] > key; --i)
+                    d[i] = d[i - 1];
+                d[i] = key;
+            }
         }
     }
 };

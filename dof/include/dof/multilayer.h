@@ -45,13 +45,18 @@ enum class LevelFilter : uint8_t {
 
 struct MultilayerSettings {
     uint32_t fragments_per_pixel = 4; // §4: closest N kept per pixel (paper: 3-4; 16); 0 = all
-    uint32_t mip_levels = 1;          // §5.2 Y-map: mip steps before the stack (Table 3: 1/3)
-    int32_t stack_levels = -1;        // stack steps; -1 = auto: until the top level's filter
-                                      // matches the largest |C(d)| of the collected fragments
-    float epsilon = 0.2f;             // §5.1 depth threshold, relative to the depth
-    bool truncate = true;             // §6.2 fragment list truncation
-    bool mean_depth = true; // merged fragments carry their mean depth (LevelPlan::mean_depth);
-                            // false: the closest one's, as the paper
+    // §4 cap over the fragments that can be seen: a fragment within ε (the merge threshold)
+    // behind an opaque fragment of its own pixel is skipped (raster::FragmentListDesc::
+    // hidden_epsilon), so that a stack of leaves does not take every slot and hide the ground
+    // behind them from the filtered levels. false: the paper's closest N of all fragments.
+    bool skip_hidden = true;
+    uint32_t mip_levels = 1;   // §5.2 Y-map: mip steps before the stack (Table 3: 1/3)
+    int32_t stack_levels = -1; // stack steps; -1 = auto: until the top level's filter
+                               // matches the largest |C(d)| of the collected fragments
+    float epsilon = 0.2f;      // §5.1 depth threshold, relative to the depth
+    bool truncate = true;      // §6.2 fragment list truncation
+    bool mean_depth = true;    // merged fragments carry their mean depth (LevelPlan::mean_depth);
+                               // false: the closest one's, as the paper
     LayerBlend blend = LayerBlend::Additive; // §7: the paper's general choice
     // Additive blending: a slice joins the group of the previous one when its depth is within
     // a factor (1 + additive_gap) of it; groups are combined with the over operator. +inf:
@@ -111,6 +116,7 @@ struct MultilayerStats {
     double ms_accumulate = 0.0;       // §6.1: traversal and blending
     uint64_t fragments_collected = 0; // before the N cap (after early rejection)
     uint64_t fragments_rejected = 0;  // rejected before shading: N nearer ones already collected
+    uint64_t fragments_hidden = 0;    // skipped by the cap as hidden (skip_hidden)
     uint64_t fragments_kept = 0;      // after the cap
     uint32_t max_list_length = 0; // longest list appended (after early rejection, before the cap)
     bool node_pool_grew = false;

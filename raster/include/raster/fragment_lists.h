@@ -4,8 +4,8 @@
 //
 // Collection appends fragments in primitive order to per-pixel lists (a head index per pixel and
 // a next index per node in a node pool of explicit capacity). The resolve sorts each list by
-// depth (ties by primitive id), keeps the closest N and compacts all lists into consecutive
-// arrays with a prefix sum over the counts. Owns its arrays.
+// depth (ties by primitive id), keeps the closest N (optionally skipping hidden fragments) and
+// compacts all lists into consecutive arrays with a prefix sum over the counts. Owns its arrays.
 #pragma once
 
 #include <raster/storage.h>
@@ -30,6 +30,12 @@ struct FragmentListDesc {
     // have N nearer ones in their pixel: the same lists, fewer fragments shaded and sorted. Off:
     // every fragment is collected, as on the GPU (to inspect the uncapped list lengths).
     bool early_reject = true;
+    // > 0: a fragment behind an opaque fragment of its own pixel by at most this factor of the
+    // view distance (d <= d_o (1 + ε), d_o kept) is hidden, and the resolve skips it when it
+    // picks the closest N, so the N slots go to fragments that can be seen. The multi-layer
+    // merge (Selgrad et al. §5.1) gives such a fragment no weight whenever it shares the opaque
+    // one's ε window; dof::Multilayer passes its ε. 0: the closest N of all fragments.
+    float hidden_epsilon = 0.0f;
 };
 constexpr uint32_t kMaxEarlyRejectCap = 16;
 
@@ -48,6 +54,7 @@ struct FragmentLists {
     // Counts from the collection pass.
     uint64_t fragments_collected = 0; // nodes appended (every fragment without early rejection)
     uint64_t fragments_rejected = 0;  // rejected early (desc.early_reject), never shaded
+    uint64_t fragments_hidden = 0;    // skipped as hidden (desc.hidden_epsilon) by the resolve
     uint64_t fragments_kept = 0;      // after the closest-N cap
     uint32_t max_list_length = 0; // longest list appended (after early rejection, before the cap)
     uint32_t node_capacity_used = 0; // capacity of the pool that succeeded

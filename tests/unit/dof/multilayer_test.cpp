@@ -295,6 +295,35 @@ TEST(Multilayer, OpaqueSurfacesStayOpaqueThroughTheLevels) {
     }
 }
 
+TEST(Multilayer, StackedLeavesLeaveASlotForTheWallBehind) {
+    // Four opaque 8 px squares stacked within ε at d = 50..53 (C = -12 px) in front of a red
+    // wall in focus that fills the view, over a blue background. The blurred stack covers
+    // little of its own pixels, so they show the wall. With the paper's closest N = 4 the
+    // stack takes all four slots there, the wall is dropped and the background shows through
+    // instead; skipping the hidden fragments keeps the wall in every list.
+    const raster::View view = testView();
+    raster::Scene scene;
+    scene.background = glm::vec3(0.0f, 0.0f, 1.0f);
+    const int32_t red = addMaterial(scene, flatMaterial({1.0f, 0.0f, 0.0f, 1.0f}));
+    const int32_t green = addMaterial(scene, flatMaterial({0.0f, 1.0f, 0.0f, 1.0f}));
+    addQuad(scene, -60.0f, -60.0f, 60.0f, 60.0f, kFocus, red);
+    for (float d : {50.0f, 51.0f, 52.0f, 53.0f})
+        addQuad(scene, -0.04f * d, -0.04f * d, 0.04f * d, 0.04f * d, d, green);
+    const dof::ThinLens lens = dof::makeThinLens(view, 12.0f, kFocus);
+    float max_blue[2] = {0.0f, 0.0f};
+    for (bool skip : {false, true}) {
+        dof::MultilayerSettings settings;
+        settings.skip_hidden = skip;
+        const MlRun ml = runMultilayer(scene, view, lens, settings);
+        EXPECT_EQ(ml.stats.fragments_hidden > 0, skip);
+        for (uint32_t y = 0; y < kH; ++y)
+            for (uint32_t x = 0; x < kW; ++x)
+                max_blue[skip] = std::max(max_blue[skip], channel(ml.image, x, y, 2));
+    }
+    EXPECT_GT(max_blue[0], 0.5f);  // the hole the cap makes
+    EXPECT_LT(max_blue[1], 2e-3f); // kOpaque: the traversal stops 1/1024 short of opaque
+}
+
 TEST(Multilayer, SlantedOpaqueSurfaceHidesTheBackground) {
     // A black plane slanted from depth 40 to 70 in front of the focal plane (C = -18 ... -5 px)
     // covers the view and more, in front of a white background: every lens ray meets it, so

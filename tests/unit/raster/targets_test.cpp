@@ -317,6 +317,89 @@ TEST(FragmentLists, EarlyRejectionKeepsTheSameListsOnFoliage) {
     }
 }
 
+TEST(FragmentLists, HiddenFragmentsGiveTheirSlotsToVisibleOnes) {
+    // Full-view quads at the centre pixel, near to far: a BLEND pane at 1.5 (hides nothing), an
+    // opaque 1.6, an opaque 1.7 (within 20% behind 1.6: hidden), an opaque 2.5, an opaque 2.9
+    // (hidden by 2.5) and an opaque 4.0. Submitted far to near, so that early rejection sees
+    // the hidden ones before what hides them.
+    raster::Scene s;
+    s.background = glm::vec3(0.0f);
+    const float depths[] = {4.0f, 2.9f, 2.5f, 1.7f, 1.6f, 1.5f};
+    for (float d : depths) {
+        const bool pane = d == 1.5f;
+        const int32_t m = addMaterial(
+            s, flatMaterial({0.5f, 0.5f, 0.5f, pane ? 0.5f : 1.0f},
+                            pane ? raster::AlphaMode::Blend : raster::AlphaMode::Opaque));
+        addMesh(s, {{-d, -d, -d}, {d, -d, -d}, {d, d, -d}, {-d, d, -d}}, {0, 1, 2, 0, 2, 3}, m);
+    }
+    const raster::View v = stackView();
+    auto centre = [&](const raster::FragmentLists& fl) {
+        const size_t p = size_t(v.height / 2) * v.width + v.width / 2;
+        std::vector<float> d;
+        for (uint32_t i = fl.offsets[p]; i < fl.offsets[p + 1]; ++i)
+            d.push_back(raster::distanceFromDepth(v, fl.depth.load(i)));
+        return d;
+    };
+    auto near = [](const std::vector<float>& got, const std::vector<float>& want) {
+        if (got.size() != want.size())
+            return false;
+        for (size_t i = 0; i < got.size(); ++i)
+            if (std::abs(got[i] - want[i]) > 1e-3f * want[i])
+                return false;
+        return true;
+    };
+    raster::FragmentListDesc closest;
+    closest.max_per_pixel = 4;
+    raster::FragmentListDesc visible = closest;
+    visible.hidden_epsilon = 0.2f;
+    raster::FragmentListDesc visible_full = visible;
+    visible_full.early_reject = false;
+    const raster::FragmentLists a = lists(s, v, closest), b = lists(s, v, visible),
+                                c = lists(s, v, visible_full);
+    EXPECT_TRUE(near(centre(a), {1.5f, 1.6f, 1.7f, 2.5f}));
+    EXPECT_TRUE(near(centre(b), {1.5f, 1.6f, 2.5f, 4.0f}));
+    EXPECT_EQ(a.fragments_hidden, 0u);
+    EXPECT_EQ(b.fragments_hidden, 2u * v.width * v.height); // 1.7 and 2.9 everywhere
+    EXPECT_EQ(b.offsets, c.offsets);
+    EXPECT_EQ(b.depth.float32, c.depth.float32);
+    EXPECT_EQ(b.primitive, c.primitive);
+    raster::FragmentListDesc bad = visible;
+    bad.hidden_epsilon = -1.0f;
+    raster::TaskPool pool(0);
+    raster::Renderer r(pool);
+    raster::FragmentLists out;
+    EXPECT_FALSE(r.renderFragmentLists(s, v, {}, bad, out).ok());
+}
+
+TEST(FragmentLists, EarlyRejectionKeepsTheSameListsWithHiddenFragments) {
+    // With hidden fragments skipped, early rejection only rejects a fragment with N nearer ones
+    // spaced by more than 1 + ε (see ListSink): on foliage the lists equal those of a full
+    // collection for every cap and ε.
+    raster::Result<raster::Scene> s = scenes::makeBuiltinScene("foliage");
+    ASSERT_TRUE(s.ok());
+    const raster::View v = raster::viewFromCamera(s->cameras[0], 160, 120);
+    for (float eps : {0.05f, 0.2f, 1.0f})
+        for (uint32_t cap : {1u, 4u, 16u}) {
+            raster::FragmentListDesc early;
+            early.max_per_pixel = cap;
+            early.hidden_epsilon = eps;
+            raster::FragmentListDesc full = early;
+            full.early_reject = false;
+            const raster::FragmentLists e = lists(*s, v, early), f = lists(*s, v, full);
+            // Rejection needs N nearer fragments spaced by 1 + ε: rare for long or wide spacing.
+            if (cap == 1 || (cap == 4 && eps <= 0.2f)) {
+                EXPECT_GT(e.fragments_rejected, 0u) << cap << " " << eps;
+            }
+            if (cap > 1) { // with one slot, the nearest fragment is the whole list
+                EXPECT_GT(f.fragments_hidden, 0u) << cap << " " << eps;
+            }
+            ASSERT_EQ(e.offsets, f.offsets) << cap << " " << eps;
+            EXPECT_EQ(e.primitive, f.primitive) << cap << " " << eps;
+            EXPECT_EQ(e.color.half, f.color.half) << cap << " " << eps;
+            EXPECT_EQ(e.depth.float32, f.depth.float32) << cap << " " << eps;
+        }
+}
+
 TEST(FragmentLists, OverflowFailsOrGrowsWithoutLoss) {
     const raster::Scene s = stackScene(true);
     const raster::View v = stackView();
