@@ -189,6 +189,7 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     out.counts = {{"fragments_collected", st.fragments_collected},
                   {"fragments_rejected_early", st.fragments_rejected},
                   {"fragments_hidden", st.fragments_hidden},
+                  {"skipped_hidden", st.skipped_hidden},
                   {"fragments_kept", st.fragments_kept},
                   {"max_list_length", st.max_list_length},
                   {"node_pool_grew", st.node_pool_grew},
@@ -233,7 +234,8 @@ MethodEntry makeMultilayerMethod() {
         render
             .add_option("--skip-hidden", args->skip_hidden,
                         "multilayer: the closest N skip fragments within --epsilon behind an "
-                        "opaque fragment of their pixel (off: the paper's closest N of all, §4)")
+                        "opaque fragment of their pixel (off: the paper's closest N of all, §4; "
+                        "no effect with --fragments-per-pixel 0)")
             ->check(CLI::IsMember({"on", "off"}))
             ->default_val("on");
         render

@@ -206,7 +206,9 @@ raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens
     raster::FragmentListDesc desc;
     desc.node_capacity = settings.node_capacity;
     desc.max_per_pixel = settings.fragments_per_pixel;
-    desc.hidden_epsilon = settings.skip_hidden ? settings.epsilon : 0.0f;
+    // Hidden fragments only matter when they compete for the N slots.
+    const bool skip_hidden = settings.skip_hidden && settings.fragments_per_pixel > 0;
+    desc.hidden_epsilon = skip_hidden ? settings.epsilon : 0.0f;
     desc.color_format = settings.color_format;
     desc.depth_format = settings.depth_format;
     desc.on_overflow = raster::OverflowPolicy::Grow;
@@ -482,6 +484,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         st.fragments_collected = lists.fragments_collected;
         st.fragments_rejected = lists.fragments_rejected;
         st.fragments_hidden = lists.fragments_hidden;
+        st.skipped_hidden = lists.desc.hidden_epsilon > 0.0f;
         st.fragments_kept = lists.fragments_kept;
         st.max_list_length = lists.max_list_length;
         st.node_pool_grew = lists.grew;

@@ -283,6 +283,8 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                                      FragmentLists& out, FrameStats* stats) {
     if (desc.node_capacity == 0)
         return Status::error("fragment list node capacity must be at least 1");
+    if (!(desc.hidden_epsilon >= 0.0f) || !std::isfinite(desc.hidden_epsilon))
+        return Status::error("fragment list hidden epsilon must be finite and >= 0");
     if (Status s = prepare(scene, view, options, stats); !s.ok())
         return s;
     State& st = *state_;
@@ -290,8 +292,6 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     const size_t pixels = size_t(view.width) * view.height;
     st.list_head.assign(pixels, kNoNode);
     st.list_pools.resize(tiles);
-    if (!(desc.hidden_epsilon >= 0.0f) || !std::isfinite(desc.hidden_epsilon))
-        return Status::error("fragment list hidden epsilon must be finite and >= 0");
     const bool early =
         desc.early_reject && desc.max_per_pixel > 0 && desc.max_per_pixel <= kMaxEarlyRejectCap;
     const float hidden_scale = desc.hidden_epsilon > 0.0f ? 1.0f + desc.hidden_epsilon : 0.0f;

@@ -129,7 +129,7 @@ constexpr uint32_t kNoNode = 0xffffffffu;
 //  - Without hidden fragments (FragmentListDesc::hidden_epsilon = 0): k = N keys, the stored
 //    depths; a fragment beyond the N-th is rejected. Exact whatever the arrival order: N
 //    fragments strictly nearer sort before it.
-//  - With them (`hidden_scale` = 1 + ε > 1): k >= N keys, the view distances; a fragment is
+//  - With them (`hidden_scale` = 1 + ε, ε > 0): k >= N keys, the view distances; a fragment is
 //    rejected when N of the nearer keys are spaced by more than the factor 1 + ε. Each of those N
 //    is either kept by the resolve or hidden by a kept opaque fragment in front of it, and no
 //    kept fragment hides two of them (its window d_o..d_o(1 + ε) holds at most one), so N kept

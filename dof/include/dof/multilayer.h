@@ -46,9 +46,10 @@ enum class LevelFilter : uint8_t {
 struct MultilayerSettings {
     uint32_t fragments_per_pixel = 4; // §4: closest N kept per pixel (paper: 3-4; 16); 0 = all
     // §4 cap over the fragments that can be seen: a fragment within ε (the merge threshold)
-    // behind an opaque fragment of its own pixel is skipped (raster::FragmentListDesc::
-    // hidden_epsilon), so that a stack of leaves does not take every slot and hide the ground
-    // behind them from the filtered levels. false: the paper's closest N of all fragments.
+    // behind a kept opaque fragment of its own pixel takes no slot (raster::FragmentListDesc::
+    // hidden_epsilon), so that a stack of leaves does not take every slot and push the ground
+    // behind them out of the lists. No effect with fragments_per_pixel = 0 (no slots to compete
+    // for) or ε = 0. false: the paper's closest N of all fragments.
     bool skip_hidden = true;
     uint32_t mip_levels = 1;   // §5.2 Y-map: mip steps before the stack (Table 3: 1/3)
     int32_t stack_levels = -1; // stack steps; -1 = auto: until the top level's filter
@@ -116,8 +117,10 @@ struct MultilayerStats {
     double ms_accumulate = 0.0;       // §6.1: traversal and blending
     uint64_t fragments_collected = 0; // before the N cap (after early rejection)
     uint64_t fragments_rejected = 0;  // rejected before shading: N nearer ones already collected
+                                      // (with skip_hidden: N spaced by more than 1 + ε)
     uint64_t fragments_hidden = 0;    // skipped by the cap as hidden (skip_hidden)
-    uint64_t fragments_kept = 0;      // after the cap
+    bool skipped_hidden = false;  // the cap skipped hidden fragments (skip_hidden, N > 0, ε > 0)
+    uint64_t fragments_kept = 0;  // after the cap
     uint32_t max_list_length = 0; // longest list appended (after early rejection, before the cap)
     bool node_pool_grew = false;
     uint32_t mip_levels = 0;

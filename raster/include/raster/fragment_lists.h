@@ -34,7 +34,8 @@ struct FragmentListDesc {
     // view distance (d <= d_o (1 + ε), d_o kept) is hidden, and the resolve skips it when it
     // picks the closest N, so the N slots go to fragments that can be seen. The multi-layer
     // merge (Selgrad et al. §5.1) gives such a fragment no weight whenever it shares the opaque
-    // one's ε window; dof::Multilayer passes its ε. 0: the closest N of all fragments.
+    // one's ε window (the skipped range is a superset of that: a window can start between d_o
+    // and the fragment); dof::Multilayer passes its ε. 0: the closest N of all fragments.
     float hidden_epsilon = 0.0f;
 };
 constexpr uint32_t kMaxEarlyRejectCap = 16;

@@ -318,13 +318,14 @@ TEST(FragmentLists, EarlyRejectionKeepsTheSameListsOnFoliage) {
 }
 
 TEST(FragmentLists, HiddenFragmentsGiveTheirSlotsToVisibleOnes) {
-    // Full-view quads at the centre pixel, near to far: a BLEND pane at 1.5 (hides nothing), an
-    // opaque 1.6, an opaque 1.7 (within 20% behind 1.6: hidden), an opaque 2.5, an opaque 2.9
-    // (hidden by 2.5) and an opaque 4.0. Submitted far to near, so that early rejection sees
-    // the hidden ones before what hides them.
+    // Full-view quads, near to far: a BLEND pane at 1.5 (hides nothing), an opaque 1.6, an
+    // opaque 1.7 (within 20 % behind 1.6: hidden), opaque 2.5, 2.9 (hidden by 2.5), 4.0, 5.0
+    // and 6.0. Submitted near to far, so that early rejection meets every fragment with its
+    // nearer ones collected: 4.0 has four nearer ones but must be kept; 6.0 has 1.5, 2.5, 4.0
+    // and 5.0 spaced by more than 1.2 in front of it and is rejected.
     raster::Scene s;
     s.background = glm::vec3(0.0f);
-    const float depths[] = {4.0f, 2.9f, 2.5f, 1.7f, 1.6f, 1.5f};
+    const float depths[] = {1.5f, 1.6f, 1.7f, 2.5f, 2.9f, 4.0f, 5.0f, 6.0f};
     for (float d : depths) {
         const bool pane = d == 1.5f;
         const int32_t m = addMaterial(
@@ -359,7 +360,9 @@ TEST(FragmentLists, HiddenFragmentsGiveTheirSlotsToVisibleOnes) {
     EXPECT_TRUE(near(centre(a), {1.5f, 1.6f, 1.7f, 2.5f}));
     EXPECT_TRUE(near(centre(b), {1.5f, 1.6f, 2.5f, 4.0f}));
     EXPECT_EQ(a.fragments_hidden, 0u);
-    EXPECT_EQ(b.fragments_hidden, 2u * v.width * v.height); // 1.7 and 2.9 everywhere
+    EXPECT_EQ(b.fragments_hidden, 2u * v.width * v.height);   // 1.7 and 2.9 everywhere
+    EXPECT_EQ(b.fragments_rejected, 1u * v.width * v.height); // 6.0 everywhere
+    EXPECT_EQ(c.fragments_hidden, b.fragments_hidden);
     EXPECT_EQ(b.offsets, c.offsets);
     EXPECT_EQ(b.depth.float32, c.depth.float32);
     EXPECT_EQ(b.primitive, c.primitive);
@@ -394,6 +397,7 @@ TEST(FragmentLists, EarlyRejectionKeepsTheSameListsWithHiddenFragments) {
                 EXPECT_GT(f.fragments_hidden, 0u) << cap << " " << eps;
             }
             ASSERT_EQ(e.offsets, f.offsets) << cap << " " << eps;
+            EXPECT_EQ(e.fragments_hidden, f.fragments_hidden) << cap << " " << eps;
             EXPECT_EQ(e.primitive, f.primitive) << cap << " " << eps;
             EXPECT_EQ(e.color.half, f.color.half) << cap << " " << eps;
             EXPECT_EQ(e.depth.float32, f.depth.float32) << cap << " " << eps;
@@ -428,18 +432,23 @@ TEST(FragmentLists, BitIdenticalAcrossThreadsAndTilesOnFoliage) {
     raster::Result<raster::Scene> s = scenes::makeBuiltinScene("foliage");
     ASSERT_TRUE(s.ok());
     const raster::View v = raster::viewFromCamera(s->cameras[0], 120, 90);
-    const raster::FragmentLists ref = lists(*s, v, {}, 0, 64);
-    EXPECT_GT(ref.max_list_length, 4u);
-    for (uint32_t threads : {1u, 3u, 8u})
-        for (uint32_t tile : {16u, 32u, 128u}) {
-            const raster::FragmentLists other = lists(*s, v, {}, threads, tile);
-            EXPECT_EQ(other.offsets, ref.offsets);
-            EXPECT_EQ(other.primitive, ref.primitive);
-            EXPECT_EQ(other.depth.float32, ref.depth.float32);
-            ASSERT_EQ(other.color.half.size(), ref.color.half.size());
-            for (size_t i = 0; i < ref.color.half.size(); ++i)
-                ASSERT_EQ(other.color.half[i].bits(), ref.color.half[i].bits());
-        }
+    for (float eps : {0.0f, 0.2f}) { // the closest N; with hidden fragments skipped
+        raster::FragmentListDesc desc;
+        desc.hidden_epsilon = eps;
+        const raster::FragmentLists ref = lists(*s, v, desc, 0, 64);
+        EXPECT_GT(ref.max_list_length, 4u);
+        EXPECT_EQ(ref.fragments_hidden > 0, eps > 0.0f);
+        for (uint32_t threads : {1u, 3u, 8u})
+            for (uint32_t tile : {16u, 32u, 128u}) {
+                const raster::FragmentLists other = lists(*s, v, desc, threads, tile);
+                EXPECT_EQ(other.offsets, ref.offsets);
+                EXPECT_EQ(other.primitive, ref.primitive);
+                EXPECT_EQ(other.depth.float32, ref.depth.float32);
+                ASSERT_EQ(other.color.half.size(), ref.color.half.size());
+                for (size_t i = 0; i < ref.color.half.size(); ++i)
+                    ASSERT_EQ(other.color.half[i].bits(), ref.color.half[i].bits());
+            }
+    }
 }
 
 } // namespace
