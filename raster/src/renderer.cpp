@@ -26,8 +26,8 @@ struct Renderer::State {
     std::vector<uint32_t> list_head;
     std::vector<std::vector<FragmentNode>> list_pools;
     std::vector<std::vector<FragmentNode>> sort_scratch;
-    std::vector<std::vector<FragmentNode>>
-        list_kept; // per tile: its lists as the resolve keeps them
+    // Per tile: its lists as the resolve keeps them, until they are copied into place.
+    std::vector<std::vector<FragmentNode>> list_kept;
     // ListSink early rejection: per worker, the k nearest depths of each pixel of its tile.
     std::vector<std::vector<float>> list_nearest;
 };
