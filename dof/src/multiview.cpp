@@ -979,17 +979,17 @@ float meanNeighbourDistance(const LensSampleSet& samples) {
 
 std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fine_per_sample) {
     const uint32_t n = samples.size();
-    std::vector<glm::vec2> offsets(n, glm::vec2(0.0f));
     const uint64_t wanted = uint64_t(n) * std::max(fine_per_sample, 1u);
     const uint32_t fine_count = uint32_t(std::min<uint64_t>(wanted, 65536));
     // Under 16 points a cell, the centroids are noise (at 64k samples Hammersley's denser set is
     // the set itself); such sets have cones under a pixel wide anyway: keep them on the rays.
     if (n == 0 || uint64_t(fine_count) < 16 * uint64_t(n))
-        return offsets;
+        return {};
     raster::Result<LensSampleSet> fine =
         LensSampleSet::create(samples.shape(), LensPattern::Hammersley, fine_count, 0);
     if (!fine.ok())
-        return offsets; // the shape built the main set, so it builds this one too
+        return {}; // the shape built the main set, so it builds this one too
+    std::vector<glm::vec2> offsets(n, glm::vec2(0.0f));
     const SampleGrid grid(samples);
     std::vector<glm::dvec2> sum(n, glm::dvec2(0.0));
     std::vector<double> weight(n, 0.0);
@@ -1093,14 +1093,14 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         r_max = std::max(r_max, glm::length(ls.position));
     if (settings.cone && settings.cone_centre == ConeCentre::Cell &&
         settings.jitter == JitterMode::None) {
-        stats.cones_on_cells = true;
         const std::vector<glm::vec2> cells = lensCellOffsets(samples);
-        for (uint32_t k = 0; k < samples.size(); ++k) {
-            tr.cone_offsets.push_back(glm::vec2(-cells[k].x, cells[k].y));
+        for (uint32_t k = 0; k < cells.size(); ++k) {
+            tr.cone_offsets.push_back(lensRayImageOffset(1.0f, cells[k]));
             // The culling windows (and N-buffer levels) bound every cone centre as every ray.
             r_max = std::max(r_max, glm::length(samples.sample(k).position + cells[k]));
         }
     }
+    stats.cones_on_cells = !tr.cone_offsets.empty();
     if (settings.jitter == JitterMode::Halton)
         for (const LensSample& ls : settings.sequence_2n->samples())
             r_max = std::max(r_max, glm::length(ls.position));

@@ -226,8 +226,9 @@ float meanNeighbourDistance(const LensSampleSet& samples);
 // in lens units (ConeCentre::Cell). The cell is measured on a Hammersley set (seed 0) on the
 // same aperture, `fine_per_sample` points per sample and at most 65536 in all: each point goes
 // to its nearest sample (ties: the lower index) and the centroid is the weighted mean of a
-// sample's points (a sample without points keeps offset 0). All offsets are 0 when that leaves
-// fewer than 16 points a sample (more than 4096 samples by default).
+// sample's points (a sample without points keeps offset 0). Empty when that leaves fewer than
+// 16 points a sample (more than 4096 samples by default): the cells are not measured, and the
+// cones stay on the rays.
 std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fine_per_sample = 64);
 
 // The view-dependent shading context (§5): the scene whose lights shade each hit with the
