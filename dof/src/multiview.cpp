@@ -41,6 +41,13 @@ constexpr float kMaxReachPx = float(1u << 24);
 constexpr uint32_t kRayCullMinCells = 8;
 constexpr float kPi = 3.14159265358979f;
 
+// The mip levels a trilinear lookup of a `diameter`-pixel window reads (§4.4): l0 and l1 = l0 + 1
+// (clamped to the top level), blended by f.
+struct MipLevel {
+    uint32_t l0 = 0, l1 = 0;
+    float f = 0.0f;
+};
+
 // Per-layer constants of the traversal, in stored depth D (the ray is a straight line in
 // (x, y, D) because both the image offset C and D are affine in 1/d: Eq. 3 and camera.h).
 struct LayerSeg {
@@ -51,6 +58,7 @@ struct LayerSeg {
     // (MultiviewSettings::cone_misses); the lookup reads texels within cone_px of the ray's
     // position there (0: misses are not coned).
     float t_cone = 0.0f, cone_px = 0.0f;
+    MipLevel cone_level; // the levels of that first lookup (its diameter is lambda |C(t_cone)|)
     bool empty = true;
     bool transparent = false; // the transparent plane has content
 };
@@ -320,32 +328,47 @@ Hit scanPath(const Tracer& tr, const float* depth, float seg_near, float s1, uin
     return hit;
 }
 
+MipLevel mipLevelFor(const Tracer& tr, float diameter) {
+    const uint32_t top = uint32_t(tr.scratch->mip_width.size()) - 1;
+    // log2(1) = 0: windows up to a pixel read level 0 without the logarithm.
+    const float level =
+        diameter > 1.0f ? std::clamp(std::log2(diameter), 0.0f, float(top)) : 0.0f;
+    const uint32_t l0 = uint32_t(level);
+    return {l0, std::min(l0 + 1, top), level - float(l0)};
+}
+
 // Trilinear lookup of the first C channels of a layer mipmap `mip` with Stride channels per
-// texel (§4.4) at image position (px, py) for a window of `diameter` pixels.
+// texel (§4.4) at image position (px, py) on the levels `lv`.
 template <int C, int Stride = C>
 std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<float>>& mip,
-                               float px, float py, float diameter) {
+                               float px, float py, MipLevel lv) {
     const MultiviewScratch& sc = *tr.scratch;
-    const uint32_t top = uint32_t(sc.mip_width.size()) - 1;
-    const float level = std::clamp(std::log2(std::max(diameter, 1.0f)), 0.0f, float(top));
-    const uint32_t l0 = uint32_t(level);
-    const uint32_t l1 = std::min(l0 + 1, top);
-    const float f = level - float(l0);
-    auto bilinear = [&](uint32_t lv) {
-        const std::vector<float>& img = mip[lv];
-        const int64_t w = sc.mip_width[lv], h = sc.mip_height[lv];
-        const float scale = 1.0f / float(1u << lv);
+    auto bilinear = [&](uint32_t level) {
+        const float* img = mip[level].data();
+        const int64_t w = sc.mip_width[level], h = sc.mip_height[level];
+        const float scale = 1.0f / float(1u << level);
         const float u = px * scale - 0.5f, v = py * scale - 0.5f;
         const float fu = std::floor(u), fv = std::floor(v);
         const float au = u - fu, av = v - fv;
-        // The four texels, clamped to the level (the position may lie far outside it when a
-        // clamped ray read a border texel).
-        const int64_t iu = int64_t(std::clamp(fu, -1.0f, float(w)));
-        const int64_t iv = int64_t(std::clamp(fv, -1.0f, float(h)));
-        const int64_t x0 = std::clamp<int64_t>(iu, 0, w - 1) * Stride;
-        const int64_t x1 = std::clamp<int64_t>(iu + 1, 0, w - 1) * Stride;
-        const float* r0 = img.data() + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * Stride;
-        const float* r1 = img.data() + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * Stride;
+        const float* r0;
+        const float* r1;
+        int64_t x0, x1;
+        if (fu >= 0.0f && fv >= 0.0f && fu < float(w - 1) && fv < float(h - 1)) {
+            // Inside the level: the four texels need no clamping (the usual case).
+            x0 = int64_t(fu) * Stride;
+            x1 = x0 + Stride;
+            r0 = img + size_t(int64_t(fv) * w) * Stride;
+            r1 = r0 + size_t(w) * Stride;
+        } else {
+            // Clamped to the level (the position may lie far outside it when a clamped ray
+            // read a border texel).
+            const int64_t iu = int64_t(std::clamp(fu, -1.0f, float(w)));
+            const int64_t iv = int64_t(std::clamp(fv, -1.0f, float(h)));
+            x0 = std::clamp<int64_t>(iu, 0, w - 1) * Stride;
+            x1 = std::clamp<int64_t>(iu + 1, 0, w - 1) * Stride;
+            r0 = img + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * Stride;
+            r1 = img + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * Stride;
+        }
         std::array<float, C> out;
         for (int c = 0; c < C; ++c) {
             const float top_row = r0[x0 + c] * (1.0f - au) + r0[x1 + c] * au;
@@ -354,13 +377,20 @@ std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<f
         }
         return out;
     };
-    std::array<float, C> c0 = bilinear(l0);
-    if (l1 == l0 || f == 0.0f)
+    std::array<float, C> c0 = bilinear(lv.l0);
+    if (lv.l1 == lv.l0 || lv.f == 0.0f)
         return c0;
-    const std::array<float, C> c1 = bilinear(l1);
+    const std::array<float, C> c1 = bilinear(lv.l1);
     for (int c = 0; c < C; ++c)
-        c0[c] = c0[c] * (1.0f - f) + c1[c] * f;
+        c0[c] = c0[c] * (1.0f - lv.f) + c1[c] * lv.f;
     return c0;
+}
+
+// The same for a window of `diameter` pixels.
+template <int C, int Stride = C>
+std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<float>>& mip,
+                               float px, float py, float diameter) {
+    return sampleMip<C, Stride>(tr, mip, px, py, mipLevelFor(tr, diameter));
 }
 
 // A layer's premultiplied coverage mipmap (RGBA, alpha = coverage) at a cone (§4.4).
@@ -545,15 +575,8 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
     float px = 0.0f, py = 0.0f;
     if (!at(seg.t_cone, px, py))
         return std::nullopt;
-    // Nothing of the layer within the first lookup's reach (one N-buffer query, lossless).
-    if (tr.settings->culling &&
-        boxCulled(tr, l, int64_t(std::floor(px - seg.cone_px)),
-                  int64_t(std::floor(px + seg.cone_px)), int64_t(std::floor(py - seg.cone_px)),
-                  int64_t(std::floor(py + seg.cone_px))))
-        return std::nullopt;
     const std::vector<std::vector<float>>& owned = tr.scratch->owned_mips[l];
-    const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(
-        tr, owned, px, py, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
+    const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(tr, owned, px, py, seg.cone_level);
     if (!(d[1] > 0.0f))
         return std::nullopt;
     MissCone cone;
@@ -1298,6 +1321,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                 });
         });
     }
+    for (LayerSeg& seg : tr.segs)
+        if (seg.cone_px > 0.0f)
+            seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
     stats.ms_mipmaps = msSince(t0);
     for (uint32_t l = 0; l < m; ++l) {
         for (const std::vector<float>& lv : scratch.nbuffers[l].levels)
