@@ -99,7 +99,7 @@ TEST_F(BenchQuick, WritesParsableResults) {
         EXPECT_EQ(splitCsv(lines[i]).size(), header.size()) << "line " << i << ": " << lines[i];
 
     // results.json: one main row per scene x method x setting (quick: 2 scenes; pinhole 1,
-    // accum 2, gather 1, multilayer 1, multiview 1 setting), plus scaling rows.
+    // accum 4, gather 1, multilayer 1, multiview 1 setting), plus scaling rows.
     const nlohmann::json doc = nlohmann::json::parse(readAll(dir_ / "results.json"));
     ASSERT_TRUE(doc["rows"].is_array());
     EXPECT_EQ(doc["reference_samples"], 64);
@@ -127,7 +127,7 @@ TEST_F(BenchQuick, WritesParsableResults) {
         EXPECT_TRUE(fs::exists(dir_ / row["image"].get<std::string>()));
         EXPECT_TRUE(fs::exists(dir_ / row["diff_image"].get<std::string>()));
     }
-    EXPECT_EQ(main_rows, 2u * 6u);
+    EXPECT_EQ(main_rows, 2u * 8u);
     EXPECT_EQ(settings_of.size(), 2u * 5u);
     EXPECT_GE(scaling_rows, 2u * 5u);
 
