@@ -1,6 +1,7 @@
 #include "apps/bench_command.h"
 
 #include "apps/dof_method.h"
+#include "apps/equal_error.h"
 #include "apps/image_io.h"
 #include "apps/render_command.h"
 #include "apps/scene_source.h"
@@ -15,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -23,9 +25,12 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
+#include <spawn.h>
 #include <sstream>
+#include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
 
@@ -49,17 +54,29 @@ constexpr float kDiffScale = 0.1f;
 struct Setting {
     std::string label;
     std::vector<std::string> args;
+    bool scaling = false;  // the setting of the thread-scaling study (else the first)
+    bool temporal = false; // the setting of the temporal study (else the last)
 };
 
+// The sweeps. accum's N doubles from 4 to 256 so that every equal-error target between the
+// cheapest and the best accum is bracketed by two neighbouring settings (apps/equal_error.h);
+// the other methods cover their useful range. The studies keep the settings they had before
+// the sweeps grew: accum N = 16 (quick: 8) for both; the others' first for scaling, last for
+// temporal.
 std::vector<Setting> settingsFor(const std::string& method, bool quick) {
     if (method == "pinhole")
         return {{"default", {}}};
     if (method == "accum") {
-        if (quick)
-            return {{"N=8", {"--samples", "8"}}, {"N=32", {"--samples", "32"}}};
-        return {{"N=16", {"--samples", "16"}},
-                {"N=64", {"--samples", "64"}},
-                {"N=256", {"--samples", "256"}}};
+        const std::vector<int> ns =
+            quick ? std::vector<int>{4, 8, 16, 32} : std::vector<int>{4, 8, 16, 32, 64, 128, 256};
+        const int study = quick ? 8 : 16;
+        std::vector<Setting> out;
+        for (int n : ns)
+            out.push_back({"N=" + std::to_string(n),
+                           {"--samples", std::to_string(n)},
+                           n == study,
+                           n == study});
+        return out;
     }
     if (method == "gather") {
         auto g = [](const char* r) {
@@ -76,7 +93,9 @@ std::vector<Setting> settingsFor(const std::string& method, bool quick) {
         };
         if (quick)
             return {m("4", "16")};
-        return {m("4", "16"), m("2", "32"), m("1", "64")};
+        Setting first = m("4", "16");
+        first.scaling = true;
+        return {m("4", "8"), first, m("2", "32"), m("1", "64")};
     }
     if (method == "multilayer") {
         auto m = [](const char* n) {
@@ -87,6 +106,15 @@ std::vector<Setting> settingsFor(const std::string& method, bool quick) {
         return {m("2"), m("4"), m("8")};
     }
     return {{"default", {}}};
+}
+
+// The setting a study uses: the one flagged by `flag`, else the first (scaling) or last.
+Setting studySetting(const std::string& method, bool quick, bool Setting::*flag) {
+    const std::vector<Setting> all = settingsFor(method, quick);
+    for (const Setting& s : all)
+        if (s.*flag)
+            return s;
+    return flag == &Setting::scaling ? all.front() : all.back();
 }
 
 std::vector<std::string> allMethods() {
@@ -535,6 +563,229 @@ std::string htmlEscape(const std::string& s) {
     return o;
 }
 
+// Wall time of `focal render ARGS` run as a child process of this binary (/proc/self/exe), its
+// stdout and stderr discarded: what a user waits for (start-up, scene load, autofocus, render,
+// image write). NaN when it cannot start or fails.
+double timeRenderProcess(const std::vector<std::string>& args) {
+    constexpr double kFailed = std::numeric_limits<double>::quiet_NaN();
+    std::error_code ec;
+    const std::string exe = fs::read_symlink("/proc/self/exe", ec).string();
+    if (ec)
+        return kFailed;
+    std::vector<std::string> argv = {exe, "render"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    std::vector<char*> cargv;
+    for (std::string& a : argv)
+        cargv.push_back(a.data());
+    cargv.push_back(nullptr);
+    posix_spawn_file_actions_t files;
+    if (::posix_spawn_file_actions_init(&files) != 0)
+        return kFailed;
+    ::posix_spawn_file_actions_addopen(&files, 1, "/dev/null", O_WRONLY, 0);
+    ::posix_spawn_file_actions_addopen(&files, 2, "/dev/null", O_WRONLY, 0);
+    std::fflush(stdout);
+    std::fflush(stderr);
+    const auto start = std::chrono::steady_clock::now();
+    pid_t pid = 0;
+    const int spawned = ::posix_spawn(&pid, exe.c_str(), &files, nullptr, cargv.data(), environ);
+    ::posix_spawn_file_actions_destroy(&files);
+    if (spawned != 0)
+        return kFailed;
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR)
+            return kFailed;
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? ms : kFailed;
+}
+
+// The issue-18 error targets: full-frame SSIM and sRGB PSNR against the reference.
+struct ErrorTarget {
+    const char* label;
+    const char* metric; // a results.json row column
+    double value;
+};
+constexpr ErrorTarget kErrorTargets[] = {{"SSIM 0.97", "ssim", 0.97},
+                                         {"SSIM 0.98", "ssim", 0.98},
+                                         {"PSNR 35 dB", "psnr_srgb_db", 35.0},
+                                         {"PSNR 40 dB", "psnr_srgb_db", 40.0}};
+
+constexpr const char* kEqualErrorDefinition =
+    "Speed-up at equal error = accum's time to reach the target / the time of the method's "
+    "cheapest setting that reaches it (full-frame SSIM or sRGB PSNR against the reference). "
+    "accum's time: the metric's running maximum over increasing N, interpolated linearly in "
+    "log2 N between the two sweep settings that bracket the target; the time at that N "
+    "interpolated linearly in N between them. '>x': accum never reached the target (its largest "
+    "N's time is a lower bound); '<=x': accum's smallest N already reaches it (an upper bound). "
+    "render = the render's own median time (scene load excluded); process = median wall time "
+    "of a whole `focal render` process (start-up, load, render, image write).";
+
+// A main row as a sweep point for `metric`. A null metric with a number SSIM is +inf
+// (identical to the reference); a null SSIM is a failed comparison (NaN: ignored).
+SweepPoint sweepPointOf(const Json& row, const std::string& metric) {
+    SweepPoint p;
+    p.setting = row["setting"].get<std::string>();
+    const auto samples = row.find("samples");
+    p.samples = samples != row.end() && samples->is_number() ? samples->get<double>() : 0.0;
+    p.render_ms = row["ms_median"].get<double>();
+    const auto process = row.find("process_ms_median");
+    p.process_ms = process != row.end() && process->is_number()
+                       ? process->get<double>()
+                       : std::numeric_limits<double>::quiet_NaN();
+    const Json& v = row[metric];
+    p.value = v.is_number()           ? v.get<double>()
+              : row["ssim"].is_null() ? std::numeric_limits<double>::quiet_NaN()
+                                      : std::numeric_limits<double>::infinity();
+    return p;
+}
+
+Json accumCostJson(const AccumCost& c) {
+    Json j = {{"reach", reachName(c.reach)}};
+    if (c.reach == AccumReach::NoData)
+        return j;
+    j["samples"] = c.samples;
+    j["ms"] = c.ms;
+    if (c.reach == AccumReach::Interpolated) {
+        j["below"] = c.below;
+        j["above"] = c.above;
+    }
+    return j;
+}
+
+Json speedUpJson(const SpeedUp& s, std::span<const SweepPoint> method) {
+    const bool ratio = s.bound == RatioBound::Exact || s.bound == RatioBound::AtLeast ||
+                       s.bound == RatioBound::AtMost;
+    return {{"accum_ms", s.accum.reach == AccumReach::NoData ? Json() : Json(s.accum.ms)},
+            {"method_ms", s.method.reached ? Json(s.method.ms) : Json()},
+            {"setting", s.method.reached ? Json(method[s.method.index].setting) : Json()},
+            {"ratio", ratio ? number(s.ratio) : Json()},
+            {"bound", boundName(s.bound)},
+            {"text", formatSpeedUp(s)}};
+}
+
+// One scene's equal-error results: per target accum's cost and per layered method the
+// speed-up, for render and whole-process time.
+Json equalErrorOfScene(const std::string& spec, const Json& rows, const std::vector<size_t>& idx,
+                       const std::vector<std::string>& layered) {
+    Json targets = Json::array();
+    for (const ErrorTarget& target : kErrorTargets) {
+        auto sweep = [&](const std::string& method) {
+            std::vector<SweepPoint> pts;
+            for (size_t i : idx)
+                if (rows[i]["method"] == method)
+                    pts.push_back(sweepPointOf(rows[i], target.metric));
+            return pts;
+        };
+        const std::vector<SweepPoint> accum = sweep("accum");
+        Json t = {{"target", target.label}, {"metric", target.metric}, {"value", target.value}};
+        t["accum"] = {
+            {"render", accumCostJson(accumCostToReach(accum, target.value, TimeKind::Render))},
+            {"process", accumCostJson(accumCostToReach(accum, target.value, TimeKind::Process))}};
+        Json methods = Json::object();
+        for (const std::string& m : layered) {
+            const std::vector<SweepPoint> pts = sweep(m);
+            methods[m] = {
+                {"render",
+                 speedUpJson(speedUpAtEqualError(accum, pts, target.value, TimeKind::Render), pts)},
+                {"process",
+                 speedUpJson(speedUpAtEqualError(accum, pts, target.value, TimeKind::Process),
+                             pts)}};
+        }
+        t["methods"] = methods;
+        targets.push_back(t);
+    }
+    return {{"scene", spec}, {"targets", targets}};
+}
+
+// A table: a header and rows of cells, rendered as Markdown (report, equal_error.md) or HTML.
+struct Table {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+};
+
+// accum's cell: the N it needs and its render / process time.
+std::string accumCell(const Json& render, const Json& process) {
+    auto ms = [](const Json& c) {
+        return c["reach"] == "no_data" ? std::string("-") : fmt("%.1f", c["ms"].get<double>());
+    };
+    const std::string reach = render["reach"].get<std::string>();
+    if (reach == "no_data")
+        return "no data";
+    const std::string rel = reach == "interpolated"    ? "N="
+                            : reach == "first_setting" ? "N<="
+                                                       : "N>";
+    const std::string bound = reach == "interpolated" ? "" : reach == "first_setting" ? "<=" : ">";
+    return rel + fmt("%.3g", render["samples"].get<double>()) + ": " + bound + ms(render) + " / " +
+           (process["reach"] == "no_data" ? "" : bound) + ms(process) + " ms";
+}
+
+// A method's cell: render / process speed-up with the setting(s) that achieve them.
+std::string speedUpCell(const Json& render, const Json& process) {
+    const std::string r = render["text"].get<std::string>(), p = process["text"].get<std::string>();
+    if (render["setting"].is_null())
+        return r;
+    const std::string rs = render["setting"].get<std::string>();
+    if (process["setting"].is_null() || process["setting"] == rs)
+        return r + " / " + p + " (" + rs + ")";
+    return r + " (" + rs + ") / " + p + " (" + process["setting"].get<std::string>() + ")";
+}
+
+Table equalErrorTable(const Json& scenes, const std::vector<std::string>& layered) {
+    Table t;
+    t.header = {"scene", "target", "accum N: ms render / process"};
+    for (const std::string& m : layered)
+        t.header.push_back(m + " render / process");
+    for (const Json& scene : scenes)
+        for (const Json& target : scene["targets"]) {
+            std::vector<std::string> row = {
+                scene.value("name", scene["scene"].get<std::string>()),
+                target["target"].get<std::string>(),
+                accumCell(target["accum"]["render"], target["accum"]["process"])};
+            for (const std::string& m : layered)
+                row.push_back(
+                    speedUpCell(target["methods"][m]["render"], target["methods"][m]["process"]));
+            t.rows.push_back(row);
+        }
+    return t;
+}
+
+std::string markdownTable(const Table& t) {
+    std::vector<size_t> width(t.header.size(), 3);
+    for (size_t c = 0; c < t.header.size(); ++c) {
+        width[c] = std::max(width[c], t.header[c].size());
+        for (const auto& row : t.rows)
+            width[c] = std::max(width[c], row[c].size());
+    }
+    auto line = [&](const std::vector<std::string>& cells) {
+        std::string s = "|";
+        for (size_t c = 0; c < cells.size(); ++c)
+            s += " " + cells[c] + std::string(width[c] - cells[c].size(), ' ') + " |";
+        return s + "\n";
+    };
+    std::vector<std::string> rule;
+    for (size_t w : width)
+        rule.push_back(std::string(w, '-'));
+    std::string out = line(t.header) + line(rule);
+    for (const auto& row : t.rows)
+        out += line(row);
+    return out;
+}
+
+std::string htmlTable(const Table& t) {
+    std::string out = "<table border='1'><tr>";
+    for (const std::string& h : t.header)
+        out += "<th>" + htmlEscape(h) + "</th>";
+    out += "</tr>";
+    for (const auto& row : t.rows) {
+        out += "<tr>";
+        for (const std::string& cell : row)
+            out += "<td>" + htmlEscape(cell) + "</td>";
+        out += "</tr>";
+    }
+    return out + "</table>";
+}
+
 } // namespace
 
 CLI::App* addBenchCommand(CLI::App& app, BenchArgs& args) {
@@ -554,8 +805,9 @@ CLI::App* addBenchCommand(CLI::App& app, BenchArgs& args) {
                     "also bench the glTF files DIR/*/glTF/*.gl{tf,b} when the folder exists")
         ->capture_default_str();
     cmd->add_flag("--quick", args.quick,
-                  "CI smoke run: 160x120, builtin:demo and builtin:railing, 1-2 settings per "
-                  "method, 2 runs, a 64-view reference (below the 1024 real results need)");
+                  "CI smoke run: 160x120, builtin:demo and builtin:railing, 1 setting per "
+                  "method (accum: N = 4, 8, 16, 32), 2 runs, 1 process run, a 64-view reference "
+                  "(below the 1024 real results need)");
     cmd->add_option("--width", args.width, "image width")
         ->capture_default_str()
         ->check(CLI::Range(16, 4096));
@@ -565,6 +817,11 @@ CLI::App* addBenchCommand(CLI::App& app, BenchArgs& args) {
     cmd->add_option("--repeat", args.repeat, "timed runs per setting")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
+    cmd->add_option("--process-repeat", args.process_repeat,
+                    "timed whole `focal render` processes per setting, for the equal-error "
+                    "speed-up's process time (0: none; --quick: at most 1)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1000));
     cmd->add_option("--ref-samples", args.ref_samples, "accum views of the reference")
         ->capture_default_str()
         ->check(CLI::Range(1, 1 << 20));
@@ -590,6 +847,7 @@ int runBench(BenchArgs args) {
         args.width = 160;
         args.height = 120;
         args.repeat = 2;
+        args.process_repeat = std::min(args.process_repeat, 1u);
         args.ref_samples = 64;
         args.temporal_frames = std::min(args.temporal_frames, 3u);
         args.temporal_ref_samples = 16;
@@ -720,6 +978,28 @@ int runBench(BenchArgs args) {
                 opts += (opts.empty() ? "" : " ") + o;
             row["render_options"] = opts;
             addParams(row, r.stats);
+            row["load_ms"] = r.stats.value("load_ms", 0.0);
+            // Whole-process time of the same render (not for pinhole: it has no equal-error
+            // ratio).
+            if (study == "main" && method != "pinhole" && args.process_repeat > 0) {
+                std::vector<std::string> p = common;
+                p.insert(p.end(),
+                         {"--threads", std::to_string(threads), "--method", method, "-o",
+                          (out / "runs" / (id + "_process.exr")).string(), "--no-progress"});
+                p.insert(p.end(), setting.args.begin(), setting.args.end());
+                std::vector<double> ms;
+                for (uint32_t k = 0; k < args.process_repeat; ++k)
+                    if (const double t = timeRenderProcess(p); std::isfinite(t))
+                        ms.push_back(t);
+                if (ms.size() < args.process_repeat)
+                    std::fprintf(stderr,
+                                 "focal: bench: %s %s %s: %zu of %u render processes "
+                                 "failed\n",
+                                 scene.spec.c_str(), method.c_str(), setting.label.c_str(),
+                                 args.process_repeat - ms.size(), args.process_repeat);
+                row["process_ms_median"] = ms.empty() ? Json() : Json(median(ms));
+                row["process_runs"] = ms.size();
+            }
             if (study == "main") {
                 const std::string png = "images/" + id + ".png";
                 const std::string diff = "images/" + id + "_diff.png";
@@ -734,7 +1014,11 @@ int runBench(BenchArgs args) {
             }
             rows.push_back(row);
             progress(scene.name + " " + method + " " + setting.label + " threads=" +
-                     std::to_string(threads) + ": " + fmt("%.1f ms", row["ms_median"]) + ", PSNR " +
+                     std::to_string(threads) + ": " + fmt("%.1f ms", row["ms_median"]) +
+                     (row.contains("process_ms_median") && row["process_ms_median"].is_number()
+                          ? fmt(" (process %.1f ms)", row["process_ms_median"])
+                          : std::string()) +
+                     ", PSNR " +
                      (row["psnr_srgb_db"].is_number() ? fmt("%.2f dB", row["psnr_srgb_db"])
                                                       : std::string("inf")));
             return rows.size() - 1;
@@ -765,12 +1049,41 @@ int runBench(BenchArgs args) {
         if (!args.no_scaling && &scene == &scenes.front())
             for (const std::string& method : args.methods)
                 for (uint32_t t : thread_counts) {
-                    Result<size_t> i =
-                        runSetting(method, settingsFor(method, args.quick)[0], t, "scaling");
+                    Result<size_t> i = runSetting(
+                        method, studySetting(method, args.quick, &Setting::scaling), t, "scaling");
                     if (!i.ok())
                         return fail(i.status().message());
                 }
     }
+
+    // Speed-up at equal error over accum, per scene, target and layered method.
+    std::vector<std::string> layered;
+    for (const std::string& m : args.methods)
+        if (m != "pinhole" && m != "accum")
+            layered.push_back(m);
+    Json equal_error = {{"definition", kEqualErrorDefinition}, {"targets", Json::array()}};
+    for (const ErrorTarget& t : kErrorTargets)
+        equal_error["targets"].push_back(
+            {{"target", t.label}, {"metric", t.metric}, {"value", t.value}});
+    equal_error["methods"] = layered;
+    equal_error["process_repeat"] = args.process_repeat;
+    Json equal_scenes = Json::array();
+    const bool have_accum =
+        std::find(args.methods.begin(), args.methods.end(), "accum") != args.methods.end();
+    if (have_accum && !layered.empty())
+        for (const BenchScene& scene : scenes) {
+            Json e = equalErrorOfScene(scene.spec, rows, rows_of_scene[scene.spec], layered);
+            e["name"] = scene.name;
+            equal_scenes.push_back(e);
+        }
+    else
+        equal_error["note"] = "needs accum and at least one layered method in --methods";
+    equal_error["scenes"] = equal_scenes;
+    const Table equal_table = equalErrorTable(equal_scenes, layered);
+    const std::string equal_title =
+        "Speed-up over accum at equal error (" + std::to_string(args.width) + "x" +
+        std::to_string(args.height) + ", " + std::to_string(args.threads) +
+        " threads, reference accum " + std::to_string(args.ref_samples) + " views)";
 
     // Parallel efficiency t1 / (n * tn) of the scaling rows.
     std::map<std::string, double> t1;
@@ -854,10 +1167,9 @@ int runBench(BenchArgs args) {
             ref_flicker += meanAbs(ref_frames[k], ref_frames[k - 1]);
         ref_flicker /= double(k_frames - 1);
         for (const std::string& method : args.methods) {
-            // The most accurate setting, except accum's cheapest (its best would be the
+            // The most accurate setting, except accum's N = 16 (its best would be the
             // temporal reference itself).
-            const std::vector<Setting> all = settingsFor(method, args.quick);
-            const Setting setting = method == "accum" ? all.front() : all.back();
+            const Setting setting = studySetting(method, args.quick, &Setting::temporal);
             std::vector<ImageData> frames;
             double psnr_sum = 0.0;
             for (uint32_t k = 0; k < k_frames; ++k) {
@@ -946,6 +1258,7 @@ int runBench(BenchArgs args) {
     doc["scenes"] = scene_info;
     doc["rows"] = rows;
     doc["temporal"] = temporal;
+    doc["equal_error"] = equal_error;
     if (!plot_note.empty())
         doc["plot_note"] = plot_note;
     if (Status s = writeTextFile((out / "results.json").string(), doc.dump(2) + "\n"); !s.ok())
@@ -953,6 +1266,11 @@ int runBench(BenchArgs args) {
     if (Status s = writeTextFile((out / "results.csv").string(), toCsv(rows)); !s.ok())
         return fail(s.message());
     if (Status s = writeTextFile((out / "temporal.csv").string(), toCsv(temporal)); !s.ok())
+        return fail(s.message());
+    const std::string equal_md = markdownTable(equal_table);
+    if (Status s = writeTextFile((out / "equal_error.md").string(),
+                                 equal_title + ".\n\n" + kEqualErrorDefinition + "\n\n" + equal_md);
+        !s.ok())
         return fail(s.message());
 
     // index.html: per scene the plot, the reference and each method's best image within a few
@@ -970,6 +1288,9 @@ int runBench(BenchArgs args) {
             "results.json</a>, <a href='temporal.csv'>temporal.csv</a>.</p>";
     if (!plot_note.empty())
         html += "<p>" + htmlEscape(plot_note) + "</p>";
+    if (!equal_scenes.empty())
+        html += "<h2>" + htmlEscape(equal_title) + "</h2><p>" + htmlEscape(kEqualErrorDefinition) +
+                "</p>" + htmlTable(equal_table);
     for (const BenchScene& scene : scenes) {
         const std::vector<size_t>& idx = rows_of_scene[scene.spec];
         html += "<h2>" + htmlEscape(scene.spec) + "</h2>";
@@ -1029,8 +1350,10 @@ int runBench(BenchArgs args) {
     html += "</body></html>\n";
     if (Status s = writeTextFile((out / "index.html").string(), html); !s.ok())
         return fail(s.message());
-    std::printf("focal: bench wrote %zu rows to %s (results.csv, results.json, index.html) in "
-                "%.1f s\n",
+    if (!equal_scenes.empty())
+        std::printf("%s\n%s\n", equal_title.c_str(), equal_md.c_str());
+    std::printf("focal: bench wrote %zu rows to %s (results.csv, results.json, equal_error.md, "
+                "index.html) in %.1f s\n",
                 rows.size(), out.string().c_str(), elapsed_s);
     return 0;
 }

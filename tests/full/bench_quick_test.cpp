@@ -99,7 +99,7 @@ TEST_F(BenchQuick, WritesParsableResults) {
         EXPECT_EQ(splitCsv(lines[i]).size(), header.size()) << "line " << i << ": " << lines[i];
 
     // results.json: one main row per scene x method x setting (quick: 2 scenes; pinhole 1,
-    // accum 2, gather 1, multilayer 1, multiview 1 setting), plus scaling rows.
+    // accum 4, gather 1, multilayer 1, multiview 1 setting), plus scaling rows.
     const nlohmann::json doc = nlohmann::json::parse(readAll(dir_ / "results.json"));
     ASSERT_TRUE(doc["rows"].is_array());
     EXPECT_EQ(doc["reference_samples"], 64);
@@ -127,7 +127,7 @@ TEST_F(BenchQuick, WritesParsableResults) {
         EXPECT_TRUE(fs::exists(dir_ / row["image"].get<std::string>()));
         EXPECT_TRUE(fs::exists(dir_ / row["diff_image"].get<std::string>()));
     }
-    EXPECT_EQ(main_rows, 2u * 6u);
+    EXPECT_EQ(main_rows, 2u * 8u);
     EXPECT_EQ(settings_of.size(), 2u * 5u);
     EXPECT_GE(scaling_rows, 2u * 5u);
 
@@ -136,6 +136,39 @@ TEST_F(BenchQuick, WritesParsableResults) {
     EXPECT_EQ(doc["temporal"].size(), 5u);
     for (const auto& t : doc["temporal"])
         EXPECT_TRUE(t["flicker"].is_number() && t["reference_flicker"].is_number());
+
+    // Equal-error speed-up (issue 18): per scene, per target, per layered method, render and
+    // process time, each a ratio or a reason there is none; the whole-process time was measured.
+    const nlohmann::json& eq = doc["equal_error"];
+    ASSERT_TRUE(eq["scenes"].is_array());
+    ASSERT_EQ(eq["scenes"].size(), 2u);
+    EXPECT_EQ(eq["methods"], nlohmann::json({"gather", "multilayer", "multiview"}));
+    for (const auto& scene : eq["scenes"]) {
+        ASSERT_EQ(scene["targets"].size(), 4u);
+        for (const auto& target : scene["targets"])
+            for (const char* m : {"gather", "multilayer", "multiview"})
+                for (const char* kind : {"render", "process"}) {
+                    const nlohmann::json& c = target["methods"][m][kind];
+                    const std::string what = scene["scene"].get<std::string>() + " " +
+                                             target["target"].get<std::string>() + " " + m + " " +
+                                             kind;
+                    EXPECT_TRUE(c["accum_ms"].is_number()) << what;
+                    EXPECT_EQ(c["ratio"].is_number(), c["bound"] != "method_not_reached") << what;
+                    if (c["ratio"].is_number()) {
+                        EXPECT_NEAR(c["ratio"].get<double>(),
+                                    c["accum_ms"].get<double>() / c["method_ms"].get<double>(),
+                                    1e-9)
+                            << what;
+                    }
+                }
+    }
+    for (const auto& row : doc["rows"])
+        if (row["study"] == "main" && row["method"] != "pinhole") {
+            EXPECT_EQ(row["process_runs"], 1) << row["method"] << " " << row["setting"];
+            EXPECT_GT(row["process_ms_median"].get<double>(), 0.0);
+        }
+    EXPECT_NE(r.out.find("Speed-up over accum at equal error"), std::string::npos) << r.out;
+    EXPECT_TRUE(fs::exists(dir_ / "equal_error.md"));
 
     EXPECT_TRUE(fs::exists(dir_ / "index.html"));
     EXPECT_TRUE(fs::exists(dir_ / "temporal.csv"));
