@@ -621,15 +621,47 @@ RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<
     return p;
 }
 
-void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_layers,
-                uint32_t tile_layer_count, float* out, TileCounters& cnt) {
+// One lens ray between the layers of its pixel (traceTile traces a tile layer by layer, so each
+// ray's state waits here while the other rays of the tile meet the same layer).
+struct RayState {
+    LensSample lens;       // jittered lens position (§4.5) and weight
+    glm::vec2 w{0.0f};     // image offset per unit C (lensRayImageOffset)
+    glm::vec2 wc{0.0f};    // where its cones are centred, per unit C (ConeCentre)
+    glm::vec3 color{0.0f}; // what it has seen so far
+    float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4); 0: ended
+    float t_resume = -1.0f;
+    float t_end = 0.0f;
+    bool discarded = false; // its path starts outside the image (OffscreenPolicy::Discard)
+};
+
+// The layers a pixel's rays can meet, as bit masks over layer indices.
+struct PixelLayers {
+    uint64_t active = 0;   // not culled for the pixel (§4.3): its rays or missed cones may meet it
+    uint64_t hittable = 0; // its rays can hit it at all (else only the cones see it)
+};
+
+bool isDebugPixel(const Tracer& tr, uint32_t x, uint32_t y) {
     const MultiviewSettings& s = *tr.settings;
-    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
-    // Layers this pixel's rays or their missed cones can meet (early culling per pixel, §4.3);
-    // bit i of `hittable` is set when active[i] can be hit at all (else only cones see it).
-    std::array<uint32_t, raster::kMaxLayers> active{};
-    uint64_t hittable = 0;
-    uint32_t active_count = 0;
+    return s.debug_rays && x == s.debug_x && y == s.debug_y;
+}
+
+// The record of ray k of pixel (x, y), when it is the debug pixel (beginPixel sized them).
+MultiviewRayRecord* recordOf(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k) {
+    return isDebugPixel(tr, x, y) ? &(*tr.settings->debug_rays)[k] : nullptr;
+}
+
+// Whether pixel (x, y)'s ray with offset w lies in the image at stored depth t.
+bool rayInside(const Tracer& tr, uint32_t x, uint32_t y, glm::vec2 w, float t) {
+    const glm::vec2 o = tr.offsetOf(w, t);
+    return o.x >= -float(x) && o.y >= -float(y) && o.x < float(tr.width - x) &&
+           o.y < float(tr.height - y);
+}
+
+// Early culling per pixel (§4.3) and the start of each of its rays.
+PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_layers,
+                       uint32_t tile_layer_count, RayState* rays, TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
+    PixelLayers pl;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
         const uint32_t l = tile_layers[i];
         const float cone_px = tr.segs[l].cone_px;
@@ -638,8 +670,8 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             continue;
         }
         if (!s.culling || cone_px == 0.0f || !culled(tr, l, x, x, y, y, 0.0f))
-            hittable |= uint64_t(1) << active_count;
-        active[active_count++] = l;
+            pl.hittable |= uint64_t(1) << l;
+        pl.active |= uint64_t(1) << l;
     }
     // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
     std::array<float, 4> noise{};
@@ -649,211 +681,220 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
             noise[c] = hashToUnit(hashWords(x, y, s.seed, 0x6e6f6973u + c)) - 0.5f;
     if (s.jitter == JitterMode::Halton)
         halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
+    const uint32_t n = tr.samples->size();
+    const float t_first = tr.segs.front().t0;
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    if (isDebugPixel(tr, x, y))
+        s.debug_rays->assign(n, MultiviewRayRecord{});
+    for (uint32_t k = 0; k < n; ++k) {
+        ++cnt.rays;
+        RayState& ray = rays[k];
+        ray = RayState{};
+        ray.lens = jitteredSample(tr, x, y, k, noise, halton_offset);
+        ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
+        ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
+        ray.t_end = tr.segs.back().t1;
+        MultiviewRayRecord* rec = recordOf(tr, x, y, k);
+        if (rec) {
+            rec->lens = ray.lens.position;
+            rec->weight = ray.lens.weight;
+            rec->t_start = t_first;
+            rec->start_px = glm::vec2(cx, cy) + tr.cocOf(t_first) * ray.w;
+        }
+        if (s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_first)) {
+            ++cnt.discarded; // the path starts outside the image
+            ray.discarded = true;
+            ray.transmit = 0.0f;
+            if (rec)
+                rec->discarded = true, rec->t_end = t_first, rec->end_px = rec->start_px;
+        }
+    }
+    return pl;
+}
 
+// Ray k of pixel (x, y) through layer l (§4.3-§4.4): its opaque hit or miss, the layer's
+// transparent plane in front of it, and the cone of either.
+void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hittable, uint32_t k,
+                RayState& ray, TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
     const raster::View& view = *tr.view;
     const raster::LayeredTarget& lt = *tr.layers;
     const bool shade = s.view_dependent || s.env_map;
-    const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
-    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
-    const uint32_t n = tr.samples->size();
-    std::vector<MultiviewRayRecord>* records =
-        s.debug_rays && x == s.debug_x && y == s.debug_y ? s.debug_rays : nullptr;
-    if (records)
-        records->assign(n, MultiviewRayRecord{});
-    for (uint32_t k = 0; k < n; ++k) {
-        ++cnt.rays;
-        const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
-        const glm::vec2 w(-ls.position.x, ls.position.y); // lensRayImageOffset per unit C
-        // Where this ray's cones are centred, per unit C (ConeCentre).
-        const glm::vec2 wc = tr.cone_offsets.empty() ? w : w + tr.cone_offsets[k];
-        auto inside = [&](float t) { // (x, y) + o(t) lies in the image
-            const glm::vec2 o = tr.offsetOf(w, t);
-            return o.x >= -float(x) && o.y >= -float(y) && o.x < float(tr.width - x) &&
-                   o.y < float(tr.height - y);
-        };
-        // This ray's paths walked in advance, when every pixel shares the sample set.
-        const RayPath* paths = tr.paths.empty() ? nullptr : &tr.paths[size_t(k) * tr.segs.size()];
-        const bool discard = s.offscreen == OffscreenPolicy::Discard;
-        MultiviewRayRecord* rec = records ? &(*records)[k] : nullptr;
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    const glm::vec2 w = ray.w, wc = ray.wc;
+    MultiviewRayRecord* rec = recordOf(tr, x, y, k);
+    // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
+    const glm::vec3 shade_from =
+        s.view_dependent
+            ? view.eye + tr.lens->aperture_radius *
+                             (ray.lens.position.x * view.right + ray.lens.position.y * view.up)
+            : view.eye;
+    // §4.4: a cone of coverage v1 and colour c1 gives v1 c1 + (1 - v1) c2, c2 what the rest
+    // of the ray sees; from kFullCoverage on it blocks the ray (returns true).
+    auto blend = [&](float v1, glm::vec3 c1) {
+        if (v1 >= kFullCoverage) {
+            ray.color += ray.transmit * c1;
+            ray.transmit = 0.0f;
+            return true;
+        }
+        ray.color += ray.transmit * v1 * c1;
+        ray.transmit *= 1.0f - v1;
+        return false;
+    };
+    const LayerSeg& seg = tr.segs[l];
+    const float s0 = std::max(seg.t0, ray.t_resume);
+    if (!(s0 < seg.t1))
+        return;
+    // The whole segment's path walked in advance, unless the ray resumes inside it.
+    const RayPath* path =
+        !tr.paths.empty() && s0 == seg.t0 ? &tr.paths[size_t(k) * tr.segs.size() + l] : nullptr;
+    bool can_hit = hittable;
+    if (can_hit && s.culling && (!path || path->count > kRayCullMinCells)) {
+        // Per-ray culling: the texels this ray's segment can read lie in the box of its end
+        // points; one N-buffer query skips the height-field test when none of them is within
+        // the layer (the same test as §4.3's per-pixel culling, on a smaller window, so it is
+        // just as lossless). Short paths walked in advance are scanned without it.
+        const CellBox box = path ? CellBox{path->box_x0, path->box_x1, path->box_y0, path->box_y1}
+                                 : cellBox(tr.offsetOf(w, s0), tr.offsetOf(w, seg.t1));
+        if (boxCulled(tr, l, int64_t(x) + box.x0, int64_t(x) + box.x1, int64_t(y) + box.y0,
+                      int64_t(y) + box.y1)) {
+            ++cnt.culled_ray;
+            can_hit = false;
+        }
+    }
+    auto trace = [&](const std::vector<float>& depth, float near, float t_a, float t_b) {
+        return s.traversal == Traversal::Scan
+                   ? scanHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt)
+                   : traceHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt);
+    };
+    Hit h;
+    if (can_hit) {
+        ++cnt.layer_tests;
+        h = path ? scanPath(tr, tr.scratch->depth[l].data(), seg.t0, seg.t1, x, y, *path, cnt)
+                 : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
+    }
+    // A ray that crossed the whole segment without a hit still has a cone (missCone),
+    // composited in depth order with the transparent plane.
+    std::optional<MissCone> miss;
+    if (!h.hit && seg.cone_px > 0.0f && s0 == seg.t0)
+        miss = missCone(tr, l, cx, cy, wc, shade, shade_from, cnt);
+    auto addMiss = [&] {
+        if (blend(miss->v1, miss->c1))
+            ray.t_end = miss->t;
         if (rec) {
-            rec->lens = ls.position;
-            rec->weight = ls.weight;
-            rec->t_start = t_first;
-            rec->start_px = glm::vec2(cx, cy) + tr.cocOf(t_first) * w;
+            rec->layer = int32_t(l);
+            ++rec->missed_cones;
         }
-        if (discard && !inside(t_first)) { // the path starts outside the image
-            ++cnt.discarded;
-            if (rec)
-                rec->discarded = true, rec->t_end = t_first, rec->end_px = rec->start_px;
-            continue;
-        }
-        // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
-        const glm::vec3 shade_from =
-            s.view_dependent ? view.eye + tr.lens->aperture_radius *
-                                              (ls.position.x * view.right + ls.position.y * view.up)
-                             : view.eye;
-        glm::vec3 color(0.0f);
-        float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4)
-        // §4.4: a cone of coverage v1 and colour c1 gives v1 c1 + (1 - v1) c2, c2 what the rest
-        // of the ray sees; from kFullCoverage on it blocks the ray (returns true).
-        auto blend = [&](float v1, glm::vec3 c1) {
-            if (v1 >= kFullCoverage) {
-                color += transmit * c1;
-                transmit = 0.0f;
-                return true;
+        miss.reset();
+    };
+    // The layer's transparent plane in front of its opaque hit. The plane holds only depths of
+    // the layer's own interval (LayerSink routes each BLEND fragment to the one layer owning
+    // its depth), so only that part of the segment is searched. Its premultiplied colour is
+    // added and the rest of the ray is seen through (1 - opacity); with cone tracing both come
+    // from its mipmap (§4.4).
+    const float ta = std::max(s0, seg.own0);
+    const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
+    if (can_hit && seg.transparent && ta < tb) {
+        const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
+        if (ht.hit && miss && miss->t < ht.t)
+            addMiss(); // the missed cone's content lies in front of the pane
+        if (ht.hit && ray.transmit > 0.0f) {
+            ++cnt.transparent_hits;
+            const float ct = tr.cocOf(ht.t);
+            const glm::vec4 m = s.cone && tr.lambda * std::fabs(ct) > 1.0f
+                                    ? sampleCone(tr, tr.scratch->transparent_mips[l],
+                                                 cx + ct * wc.x, cy + ct * wc.y,
+                                                 tr.lambda * std::fabs(ct))
+                                    : lt.transparent_color.load(lt.index(l, ht.texel));
+            glm::vec3 rgb(m);
+            const size_t ti = lt.index(l, ht.texel);
+            if (shade && lt.transparent_top_alpha[ti] > 0.0f) {
+                // §5 for the plane: the composite is linear in its top pane's colour, which the
+                // rasterizer shaded from the lens centre; swap in the top pane shaded from this
+                // ray's origin (scaled by the cone's share of the texel's opacity).
+                const raster::GSample& g = lt.transparent_gbuffer[ti];
+                const glm::vec3 world = texelWorld(tr, ht.texel, ht.t);
+                const glm::vec3 centre = tr.shader->shade(g, world, view.eye);
+                const glm::vec3 from_ray = shadeSample(tr, g, world, shade_from);
+                const float texel_a = lt.transparent_color.load(ti).a;
+                const float share = texel_a > 0.0f ? std::min(m.a / texel_a, 1.0f) : 0.0f;
+                rgb += share * lt.transparent_top_alpha[ti] * (from_ray - centre);
             }
-            color += transmit * v1 * c1;
-            transmit *= 1.0f - v1;
-            return false;
-        };
-        float t_resume = -1.0f;
-        float t_end = t_last;
-        for (uint32_t i = 0; i < active_count && transmit > 0.0f; ++i) {
-            const uint32_t l = active[i];
-            const LayerSeg& seg = tr.segs[l];
-            const float s0 = std::max(seg.t0, t_resume);
-            if (!(s0 < seg.t1))
-                continue;
-            // The whole segment's path walked in advance, unless the ray resumes inside it.
-            const RayPath* path = paths && s0 == seg.t0 ? &paths[l] : nullptr;
-            bool can_hit = (hittable >> i) & 1;
-            if (can_hit && s.culling && (!path || path->count > kRayCullMinCells)) {
-                // Per-ray culling: the texels this ray's segment can read lie in the box of its
-                // end points; one N-buffer query skips the height-field test when none of them
-                // is within the layer (the same test as §4.3's per-pixel culling, on a smaller
-                // window, so it is just as lossless). Short paths walked in advance are
-                // scanned without it.
-                const CellBox box =
-                    path ? CellBox{path->box_x0, path->box_x1, path->box_y0, path->box_y1}
-                         : cellBox(tr.offsetOf(w, s0), tr.offsetOf(w, seg.t1));
-                if (boxCulled(tr, l, int64_t(x) + box.x0, int64_t(x) + box.x1, int64_t(y) + box.y0,
-                              int64_t(y) + box.y1)) {
-                    ++cnt.culled_ray;
-                    can_hit = false;
-                }
-            }
-            auto trace = [&](const std::vector<float>& depth, float near, float t_a, float t_b) {
-                return s.traversal == Traversal::Scan
-                           ? scanHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt)
-                           : traceHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt);
-            };
-            Hit h;
-            if (can_hit) {
-                ++cnt.layer_tests;
-                h = path ? scanPath(tr, tr.scratch->depth[l].data(), seg.t0, seg.t1, x, y, *path,
-                                    cnt)
-                         : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
-            }
-            // A ray that crossed the whole segment without a hit still has a cone (missCone),
-            // composited in depth order with the transparent plane.
-            std::optional<MissCone> miss;
-            if (!h.hit && seg.cone_px > 0.0f && s0 == seg.t0)
-                miss = missCone(tr, l, cx, cy, wc, shade, shade_from, cnt);
-            auto addMiss = [&] {
-                if (blend(miss->v1, miss->c1))
-                    t_end = miss->t;
-                if (rec) {
-                    rec->layer = int32_t(l);
-                    ++rec->missed_cones;
-                }
-                miss.reset();
-            };
-            // The layer's transparent plane in front of its opaque hit. The plane holds only
-            // depths of the layer's own interval (LayerSink routes each BLEND fragment to the
-            // one layer owning its depth), so only that part of the segment is searched. Its
-            // premultiplied colour is added and the rest of the ray is seen through
-            // (1 - opacity); with cone tracing both come from its mipmap (§4.4).
-            const float ta = std::max(s0, seg.own0);
-            const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
-            if (can_hit && seg.transparent && ta < tb) {
-                const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
-                if (ht.hit && miss && miss->t < ht.t)
-                    addMiss(); // the missed cone's content lies in front of the pane
-                if (ht.hit && transmit > 0.0f) {
-                    ++cnt.transparent_hits;
-                    const float ct = tr.cocOf(ht.t);
-                    const glm::vec4 m =
-                        s.cone && tr.lambda * std::fabs(ct) > 1.0f
-                            ? sampleCone(tr, tr.scratch->transparent_mips[l], cx + ct * wc.x,
-                                         cy + ct * wc.y, tr.lambda * std::fabs(ct))
-                            : lt.transparent_color.load(lt.index(l, ht.texel));
-                    glm::vec3 rgb(m);
-                    const size_t ti = lt.index(l, ht.texel);
-                    if (shade && lt.transparent_top_alpha[ti] > 0.0f) {
-                        // §5 for the plane: the composite is linear in its top pane's colour,
-                        // which the rasterizer shaded from the lens centre; swap in the top
-                        // pane shaded from this ray's origin (scaled by the cone's share of the
-                        // texel's opacity).
-                        const raster::GSample& g = lt.transparent_gbuffer[ti];
-                        const glm::vec3 world = texelWorld(tr, ht.texel, ht.t);
-                        const glm::vec3 centre = tr.shader->shade(g, world, view.eye);
-                        const glm::vec3 ray = shadeSample(tr, g, world, shade_from);
-                        const float texel_a = lt.transparent_color.load(ti).a;
-                        const float share = texel_a > 0.0f ? std::min(m.a / texel_a, 1.0f) : 0.0f;
-                        rgb += share * lt.transparent_top_alpha[ti] * (ray - centre);
-                    }
-                    color += transmit * rgb;
-                    transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
-                    t_end = ht.t;
-                    if (rec)
-                        rec->layer = int32_t(l);
-                }
-            }
-            if (!h.hit) {
-                if (miss)
-                    addMiss();
-                continue;
-            }
-            const float c_hit = tr.cocOf(h.t);
-            glm::vec3 c1;
-            float v1 = 1.0f;
-            const bool cone_hit = s.cone && tr.lambda * std::fabs(c_hit) > 1.0f;
-            if (cone_hit) {
-                // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha
-                // is its coverage v1, the mipmapped RGB / v1 its mean colour c1.
-                const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], cx + c_hit * wc.x,
-                                               cy + c_hit * wc.y, tr.lambda * std::fabs(c_hit));
-                v1 = std::clamp(m.a, 0.0f, 1.0f);
-                c1 = v1 > 0.0f ? glm::vec3(m) / m.a : glm::vec3(0.0f);
-            } else {
-                c1 = glm::vec3(lt.color.load(lt.index(l, h.texel)));
-            }
-            if (shade)
-                c1 = cone_hit
-                         ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * wc.x, cy + c_hit * wc.y,
-                                          0.5f * tr.lambda * std::fabs(c_hit), shade_from)
-                         : shadeHit(tr, l, h.texel, h.t, shade_from);
+            ray.color += ray.transmit * rgb;
+            ray.transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
+            ray.t_end = ht.t;
             if (rec)
                 rec->layer = int32_t(l);
-            if (blend(v1, c1)) {
-                t_end = h.t;
-                break;
-            }
-            // Continue along the centre ray for c2.
-            ++cnt.cone_partial;
-            if (rec)
-                ++rec->partial_hits;
-            t_resume = h.t_behind + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
-            t_end = h.t;
         }
-        if (transmit > 0.0f) {
+    }
+    if (!h.hit) {
+        if (miss)
+            addMiss();
+        return;
+    }
+    const float c_hit = tr.cocOf(h.t);
+    glm::vec3 c1;
+    float v1 = 1.0f;
+    const bool cone_hit = s.cone && tr.lambda * std::fabs(c_hit) > 1.0f;
+    if (cone_hit) {
+        // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha is its
+        // coverage v1, the mipmapped RGB / v1 its mean colour c1.
+        const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], cx + c_hit * wc.x,
+                                       cy + c_hit * wc.y, tr.lambda * std::fabs(c_hit));
+        v1 = std::clamp(m.a, 0.0f, 1.0f);
+        c1 = v1 > 0.0f ? glm::vec3(m) / m.a : glm::vec3(0.0f);
+    } else {
+        c1 = glm::vec3(lt.color.load(lt.index(l, h.texel)));
+    }
+    if (shade)
+        c1 = cone_hit ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * wc.x, cy + c_hit * wc.y,
+                                       0.5f * tr.lambda * std::fabs(c_hit), shade_from)
+                      : shadeHit(tr, l, h.texel, h.t, shade_from);
+    if (rec)
+        rec->layer = int32_t(l);
+    ray.t_end = h.t;
+    if (blend(v1, c1))
+        return; // the ray ends here (transmit 0)
+    // Continue along the centre ray for c2.
+    ++cnt.cone_partial;
+    if (rec)
+        ++rec->partial_hits;
+    ray.t_resume = h.t_behind + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
+}
+
+// The end of pixel (x, y)'s rays: the background behind them, the paths that left the image
+// (Discard), and the weighted mean in sample order.
+void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, float* out,
+              TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    const float t_last = tr.segs.back().t1;
+    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
+    for (uint32_t k = 0; k < tr.samples->size(); ++k) {
+        const RayState& ray = rays[k];
+        if (ray.discarded)
+            continue;
+        glm::vec3 color = ray.color;
+        float t_end = ray.t_end;
+        MultiviewRayRecord* rec = recordOf(tr, x, y, k);
+        if (ray.transmit > 0.0f) {
             ++cnt.background;
-            color += transmit * tr.background;
+            color += ray.transmit * tr.background;
             t_end = t_last;
             if (rec)
                 rec->layer = -1;
         }
         if (rec) {
             rec->t_end = t_end;
-            rec->end_px = glm::vec2(cx, cy) + tr.cocOf(t_end) * w;
+            rec->end_px = glm::vec2(cx, cy) + tr.cocOf(t_end) * ray.w;
         }
-        if (discard && !inside(t_end)) { // the path to the hit leaves the image
-            ++cnt.discarded;
+        if (s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_end)) {
+            ++cnt.discarded; // the path to the hit leaves the image
             if (rec)
                 rec->discarded = true;
             continue;
         }
-        const double wt = double(ls.weight);
+        const double wt = double(ray.lens.weight);
         sum_r += wt * double(color.r);
         sum_g += wt * double(color.g);
         sum_b += wt * double(color.b);
@@ -870,6 +911,43 @@ void tracePixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_l
         out[2] = tr.pinhole->color[i + 2];
     }
     out[3] = 1.0f;
+}
+
+// The rays of the pixels [x0, x1) x [y0, y1), layer by layer: every ray of the tile meets layer
+// l before any meets layer l + 1, so one layer's texels, mipmaps and N-buffer around the tile
+// stay in the cache while they are read (pixel by pixel, all layers of a tile do not fit in it).
+// Each ray still visits its layers front to back with the same arithmetic, so the bytes are
+// those of tracing each pixel's rays to their ends in turn. `rays` holds (x1-x0)(y1-y0)N states.
+void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+               const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
+               PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
+    const uint32_t n = tr.samples->size();
+    const uint32_t tw = x1 - x0;
+    for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+            const size_t p = size_t(y - y0) * tw + (x - x0);
+            pixel_layers[p] =
+                beginPixel(tr, x, y, tile_layers, tile_layer_count, rays + p * n, cnt);
+        }
+    for (uint32_t i = 0; i < tile_layer_count; ++i) {
+        const uint32_t l = tile_layers[i];
+        for (uint32_t y = y0; y < y1; ++y)
+            for (uint32_t x = x0; x < x1; ++x) {
+                const size_t p = size_t(y - y0) * tw + (x - x0);
+                if (!((pixel_layers[p].active >> l) & 1))
+                    continue;
+                const bool hittable = (pixel_layers[p].hittable >> l) & 1;
+                RayState* pr = rays + p * n;
+                for (uint32_t k = 0; k < n; ++k)
+                    if (pr[k].transmit > 0.0f)
+                        traceLayer(tr, x, y, l, hittable, k, pr[k], cnt);
+            }
+    }
+    for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+            const size_t p = size_t(y - y0) * tw + (x - x0);
+            endPixel(tr, x, y, rays + p * n, rgba + (size_t(y) * tr.width + x) * 4, cnt);
+        }
 }
 
 } // namespace
@@ -1370,7 +1448,10 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     const uint32_t ts = settings.tile_size;
     const uint32_t tiles_x = (width + ts - 1) / ts, tiles_y = (height + ts - 1) / ts;
     std::vector<TileCounters> counters(size_t(tiles_x) * tiles_y);
-    pool.parallelFor(tiles_x * tiles_y, [&](uint32_t tile, uint32_t) {
+    // Per worker: the states of one tile's rays and pixels.
+    std::vector<RayState> ray_states(size_t(pool.workerCount()) * ts * ts * samples.size());
+    std::vector<PixelLayers> pixel_layers(size_t(pool.workerCount()) * ts * ts);
+    pool.parallelFor(tiles_x * tiles_y, [&](uint32_t tile, uint32_t worker) {
         TileCounters& cnt = counters[tile];
         const uint32_t x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
         const uint32_t x1 = std::min(x0 + ts, width), y1 = std::min(y0 + ts, height);
@@ -1386,10 +1467,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             }
             tile_layers[count++] = l;
         }
-        for (uint32_t y = y0; y < y1; ++y)
-            for (uint32_t x = x0; x < x1; ++x)
-                tracePixel(tr, x, y, tile_layers.data(), count,
-                           rgba.data() + (size_t(y) * width + x) * 4, cnt);
+        traceTile(tr, x0, x1, y0, y1, tile_layers.data(), count,
+                  ray_states.data() + size_t(worker) * ts * ts * samples.size(),
+                  pixel_layers.data() + size_t(worker) * ts * ts, rgba.data(), cnt);
     });
     for (const TileCounters& c : counters) {
         stats.rays += c.rays;
