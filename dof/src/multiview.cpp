@@ -30,6 +30,10 @@ constexpr float kFullCoverage = 0.999f;
 constexpr int kOwnedChannels = 5;
 // Most mip levels built for cone tracing (a 256-pixel cone diameter).
 constexpr uint32_t kMaxMipLevels = 8;
+// 1 / 2^level: image positions to a level's texels.
+constexpr std::array<float, kMaxMipLevels> kMipScale = {1.0f,       0.5f,        0.25f,
+                                                        0.125f,     0.0625f,     0.03125f,
+                                                        0.015625f,  0.0078125f};
 // Most cells walked in advance (RayPath; 16 bytes each).
 constexpr double kMaxPathCells = double(1u << 22);
 // Largest image offset a ray may reach (pixels): beyond it the lens is rejected as absurd for the
@@ -81,6 +85,7 @@ struct Hit {
 // their pixels, whatever the pixel: their paths can be walked once per frame (RayPath).
 struct PathCell {
     int32_t dx = 0, dy = 0;          // texel offset from the pixel
+    int32_t offset = 0;              // dy * width + dx: the texel's index minus the pixel's
     float t_in = 0.0f, t_out = 0.0f; // stored D where the ray enters / leaves the texel's column
 };
 
@@ -287,9 +292,20 @@ void walkCells(glm::vec2 o0, glm::vec2 o1, float s0, float s1, Visit&& visit) {
     }
 }
 
-// The scan's test of the cell at offset (dx, dy) from pixel (x, y): covered as in the false
-// position (texels outside the layer's extent [seg_near, s1] are empty), the ray reaches the
-// surface inside this column and is not past its thickness.
+// The scan's test of texel `texel` of depth h, whose column the ray crosses over [t_in, t_out]:
+// covered as in the false position (texels outside the layer's extent [seg_near, s1] are
+// empty), the ray reaches the surface inside this column and is not past its thickness.
+bool cellHit(const Tracer& tr, float h, float seg_near, float s1, float t_in, float t_out,
+             uint32_t texel, Hit& hit) {
+    if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d) {
+        const float t = std::clamp(h, t_in, t_out);
+        hit = {true, t, texel, std::max(t, std::min(h + tr.thickness_d, s1))};
+        return true;
+    }
+    return false;
+}
+
+// cellHit on the cell at offset (dx, dy) from pixel (x, y), as OffscreenPolicy reads it.
 bool scanCell(const Tracer& tr, const float* depth, float seg_near, float s1, uint32_t x,
               uint32_t y, int64_t dx, int64_t dy, float t_in, float t_out, TileCounters& cnt,
               Hit& hit) {
@@ -297,13 +313,7 @@ bool scanCell(const Tracer& tr, const float* depth, float seg_near, float s1, ui
     if (!texel)
         return false;
     ++cnt.fetches;
-    const float h = depth[*texel];
-    if (h <= s1 && h >= seg_near && h <= t_out && t_in - h <= tr.thickness_d) {
-        const float t = std::clamp(h, t_in, t_out);
-        hit = {true, t, *texel, std::max(t, std::min(h + tr.thickness_d, s1))};
-        return true;
-    }
-    return false;
+    return cellHit(tr, depth[*texel], seg_near, s1, t_in, t_out, *texel, hit);
 }
 
 Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
@@ -320,8 +330,26 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
 Hit scanPath(const Tracer& tr, const float* depth, float seg_near, float s1, uint32_t x, uint32_t y,
              const RayPath& path, TileCounters& cnt) {
     Hit hit;
-    for (uint32_t i = path.first; i < path.first + path.count; ++i) {
-        const PathCell& c = tr.cells[i];
+    const PathCell* cells = tr.cells.data() + path.first;
+    if (int64_t(x) + path.box_x0 >= 0 && int64_t(y) + path.box_y0 >= 0 &&
+        int64_t(x) + path.box_x1 < int64_t(tr.width) &&
+        int64_t(y) + path.box_y1 < int64_t(tr.height)) {
+        // The whole path lies in the image: no texel is clamped or left out (scanCell's test
+        // on texels addressed by their offsets).
+        const uint32_t pixel = y * tr.width + x;
+        for (uint32_t i = 0; i < path.count; ++i) {
+            const PathCell& c = cells[i];
+            const uint32_t texel = uint32_t(int64_t(pixel) + c.offset);
+            if (cellHit(tr, depth[texel], seg_near, s1, c.t_in, c.t_out, texel, hit)) {
+                cnt.fetches += i + 1;
+                return hit;
+            }
+        }
+        cnt.fetches += path.count;
+        return hit;
+    }
+    for (uint32_t i = 0; i < path.count; ++i) {
+        const PathCell& c = cells[i];
         if (scanCell(tr, depth, seg_near, s1, x, y, c.dx, c.dy, c.t_in, c.t_out, cnt, hit))
             break;
     }
@@ -346,7 +374,7 @@ std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<f
     auto bilinear = [&](uint32_t level) {
         const float* img = mip[level].data();
         const int64_t w = sc.mip_width[level], h = sc.mip_height[level];
-        const float scale = 1.0f / float(1u << level);
+        const float scale = kMipScale[level];
         const float u = px * scale - 0.5f, v = py * scale - 0.5f;
         const float fu = std::floor(u), fv = std::floor(v);
         const float au = u - fu, av = v - fv;
@@ -614,7 +642,7 @@ RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<
     p.box_y0 = int32_t(box.y0), p.box_y1 = int32_t(box.y1);
     p.first = uint32_t(cells.size());
     walkCells(o0, o1, s0, s1, [&](int64_t dx, int64_t dy, float t_in, float t_out) {
-        cells.push_back({int32_t(dx), int32_t(dy), t_in, t_out});
+        cells.push_back({int32_t(dx), int32_t(dy), int32_t(dy * int64_t(tr.width) + dx), t_in, t_out});
         return false;
     });
     p.count = uint32_t(cells.size()) - p.first;
@@ -715,14 +743,13 @@ PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t*
 // Ray k of pixel (x, y) through layer l (§4.3-§4.4): its opaque hit or miss, the layer's
 // transparent plane in front of it, and the cone of either.
 void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hittable, uint32_t k,
-                RayState& ray, TileCounters& cnt) {
+                RayState& ray, MultiviewRayRecord* rec, TileCounters& cnt) {
     const MultiviewSettings& s = *tr.settings;
     const raster::View& view = *tr.view;
     const raster::LayeredTarget& lt = *tr.layers;
     const bool shade = s.view_dependent || s.env_map;
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
     const glm::vec2 w = ray.w, wc = ray.wc;
-    MultiviewRayRecord* rec = recordOf(tr, x, y, k);
     // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
     const glm::vec3 shade_from =
         s.view_dependent
@@ -938,9 +965,12 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                     continue;
                 const bool hittable = (pixel_layers[p].hittable >> l) & 1;
                 RayState* pr = rays + p * n;
+                MultiviewRayRecord* recs =
+                    isDebugPixel(tr, x, y) ? tr.settings->debug_rays->data() : nullptr;
                 for (uint32_t k = 0; k < n; ++k)
                     if (pr[k].transmit > 0.0f)
-                        traceLayer(tr, x, y, l, hittable, k, pr[k], cnt);
+                        traceLayer(tr, x, y, l, hittable, k, pr[k], recs ? recs + k : nullptr,
+                                   cnt);
             }
     }
     for (uint32_t y = y0; y < y1; ++y)
