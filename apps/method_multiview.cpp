@@ -422,6 +422,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                   {"rays", st.rays},
                   {"rays_discarded", st.rays_discarded},
                   {"rays_background", st.rays_background},
+                  {"layer_steps", st.layer_steps},
                   {"layer_tests", st.layer_tests},
                   {"layers_culled_pixel", st.layer_culled_pixel},
                   {"layers_culled_tile", st.layer_culled_tile},

@@ -755,6 +755,15 @@ int runRender(const RenderArgs& args) {
         if (table_method) {
             j["params"] = method_out.params;
             j["counts"] = method_out.counts;
+            // Tracing cost per lens ray and per (ray, layer) step, from the median time.
+            const nlohmann::json& c = method_out.counts;
+            const std::pair<const char*, const char*> units[] = {{"rays", "per_ray"},
+                                                                 {"layer_steps", "per_layer_step"}};
+            if (j["time_ms"].contains("tracing"))
+                for (const auto& [count, name] : units)
+                    if (c.contains(count) && c[count].get<uint64_t>() > 0)
+                        j["tracing_ns"][name] = j["time_ms"]["tracing"].get<double>() * 1e6 /
+                                                double(c[count].get<uint64_t>());
             j["lens"]["samples"] = args.samples;
             if (target_color)
                 j["target_color"] = *target_color == raster::ColorFormat::Half ? "half" : "float32";

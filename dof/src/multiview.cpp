@@ -99,7 +99,7 @@ struct RayPath {
 struct TileCounters {
     uint64_t rays = 0, discarded = 0, background = 0, layer_tests = 0, culled_pixel = 0,
              culled_tile = 0, culled_ray = 0, cone_partial = 0, cone_missed = 0, fetches = 0,
-             transparent_hits = 0;
+             transparent_hits = 0, layer_steps = 0;
 };
 
 // Everything the per-pixel loop reads; built once per frame.
@@ -768,6 +768,7 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
         ray.transmit *= 1.0f - v1;
         return false;
     };
+    ++cnt.layer_steps;
     const LayerSeg& seg = tr.segs[l];
     const float s0 = std::max(seg.t0, ray.t_resume);
     if (!(s0 < seg.t1))
@@ -1512,6 +1513,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         stats.cone_partial += c.cone_partial;
         stats.cone_missed += c.cone_missed;
         stats.texel_fetches += c.fetches;
+        stats.layer_steps += c.layer_steps;
         stats.transparent_hits += c.transparent_hits;
     }
     stats.ms_tracing = msSince(t0);

@@ -50,5 +50,25 @@ TEST(RenderCommand, MethodOptionsStartFromTheirDefaultsOnEveryParse) {
     std::filesystem::remove_all(dir);
 }
 
+TEST(RenderCommand, MultiviewStatsGiveTheTracingCostPerRayAndPerLayerStep) {
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "focal_render_command_rates_test";
+    std::filesystem::create_directories(dir);
+    const nlohmann::json j = renderStats(
+        {"--method", "multiview", "--samples", "8", "--aperture-radius", "0.3"}, dir.string());
+    const nlohmann::json& c = j["counts"];
+    ASSERT_FALSE(c["skipped"].get<bool>());
+    const double rays = c["rays"].get<double>(), steps = c["layer_steps"].get<double>();
+    EXPECT_EQ(rays, 16.0 * 12.0 * 8.0);
+    // A height-field test needs a visit; a ray visits each layer at most once.
+    EXPECT_GT(c["layer_tests"].get<double>(), 0.0);
+    EXPECT_GE(steps, c["layer_tests"].get<double>());
+    EXPECT_LE(steps, rays * c["layers"].get<double>());
+    const double ms = j["time_ms"]["tracing"].get<double>();
+    EXPECT_DOUBLE_EQ(j["tracing_ns"]["per_ray"].get<double>(), ms * 1e6 / rays);
+    EXPECT_DOUBLE_EQ(j["tracing_ns"]["per_layer_step"].get<double>(), ms * 1e6 / steps);
+    std::filesystem::remove_all(dir);
+}
+
 } // namespace
 } // namespace focal::test
