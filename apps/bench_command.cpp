@@ -268,7 +268,11 @@ struct BenchScene {
 };
 
 Result<BenchScene> prepareScene(const std::string& spec, uint32_t width, uint32_t height) {
-    Result<raster::Scene> scene = loadScene(spec);
+    // Only the view and lens are taken from the scene here (the renders run in focal render
+    // processes), so no image is decoded.
+    raster::ImportOptions no_images;
+    no_images.roles = raster::TextureRoles{};
+    Result<raster::Scene> scene = loadScene(spec, no_images);
     if (!scene.ok())
         return scene.status();
     BenchScene s;

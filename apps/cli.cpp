@@ -6,21 +6,46 @@
 #include "apps/scene_info.h"
 #include "apps/scene_source.h"
 
+#include <raster/renderer.h>
+#include <raster/task_pool.h>
+
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
+#include <thread>
 
 namespace focal {
 
 namespace {
 
-int runInfo(const std::string& spec) {
-    raster::Result<raster::Scene> scene = loadScene(spec);
+struct InfoArgs {
+    std::string scene;
+    uint32_t threads = 1;
+    bool all_images = false;
+};
+
+int runInfo(const InfoArgs& args) {
+    // Decode what some shading mode samples (so a broken colour texture is reported as a
+    // render would report it), or every image with --all-images.
+    raster::ImportOptions options;
+    if (!args.all_images) {
+        raster::TextureRoles roles;
+        for (const raster::ShadingMode mode :
+             {raster::ShadingMode::Material, raster::ShadingMode::Unlit, raster::ShadingMode::Lit})
+            roles.bits |= raster::sampledTextureRoles(mode).bits;
+        options.roles = roles;
+    }
+    raster::TaskPool pool(args.threads);
+    options.pool = &pool;
+    raster::ImportStats stats;
+    raster::Result<raster::Scene> scene = loadScene(args.scene, options, &stats);
     if (!scene.ok()) {
         std::fprintf(stderr, "focal: error: %s\n", scene.status().message().c_str());
         return 1;
     }
     std::fputs(describeScene(*scene).c_str(), stdout);
+    std::fputs(describeLoad(stats).c_str(), stdout);
     return 0;
 }
 
@@ -40,10 +65,19 @@ int runCli(int argc, char** argv) {
     BenchArgs bench_args;
     CLI::App* bench = addBenchCommand(app, bench_args);
 
-    std::string info_scene;
+    InfoArgs info_args;
+    info_args.threads = std::max(1u, std::thread::hardware_concurrency());
     CLI::App* info = app.add_subcommand("info", "Describe a scene: triangles, meshes, materials, "
-                                                "textures, cameras, bounds, extensions");
-    info->add_option("scene", info_scene, "glTF file (.gltf/.glb) or builtin:NAME")->required();
+                                                "textures, cameras, bounds, extensions, load time");
+    info->add_option("scene", info_args.scene, "glTF file (.gltf/.glb) or builtin:NAME")
+        ->required();
+    info->add_option("--threads", info_args.threads,
+                     "worker threads decoding images (0 = run inline on the caller)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 256));
+    info->add_flag("--all-images", info_args.all_images,
+                   "decode every image, also those no shading mode samples (normal, occlusion, "
+                   "metallic-roughness maps), e.g. to check that they decode");
 
     try {
         app.parse(argc, argv);
@@ -64,7 +98,7 @@ int runCli(int argc, char** argv) {
     if (bench->parsed())
         return runBench(bench_args);
     if (info->parsed())
-        return runInfo(info_scene);
+        return runInfo(info_args);
     return 2;
 }
 

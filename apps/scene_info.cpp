@@ -1,5 +1,6 @@
 #include "apps/scene_info.h"
 
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <string>
@@ -97,6 +98,17 @@ std::string textureText(const char* what, const raster::TextureRef& ref) {
     return out;
 }
 
+// ", used as base colour, emissive" (nothing for an image no material role uses).
+std::string rolesText(raster::TextureRoles roles) {
+    std::string out;
+    for (uint32_t r = 0; r < raster::kTextureRoleCount; ++r) {
+        const auto role = static_cast<raster::TextureRole>(r);
+        if (roles.has(role))
+            out += (out.empty() ? ", used as " : ", ") + std::string(raster::textureRoleName(role));
+    }
+    return out;
+}
+
 std::string joined(const std::vector<std::string>& items) {
     if (items.empty())
         return "none";
@@ -107,6 +119,18 @@ std::string joined(const std::vector<std::string>& items) {
 }
 
 } // namespace
+
+std::string describeLoad(const raster::ImportStats& stats) {
+    std::string out;
+    add(out, "load: %.1f ms (parse %.1f, images %.1f, scene %.1f); %u images decoded, %u skipped",
+        stats.ms_total, stats.ms_parse, stats.ms_images, stats.ms_scene, stats.images_decoded,
+        stats.images_skipped);
+    if (stats.images_decoded > 0)
+        add(out, "; per image, summed over threads: decode %.1f ms, mipmaps %.1f ms",
+            stats.ms_decode, stats.ms_mipmaps);
+    out += "\n";
+    return out;
+}
 
 std::string describeScene(const raster::Scene& scene) {
     std::string out;
@@ -150,16 +174,25 @@ std::string describeScene(const raster::Scene& scene) {
         out += "\n";
     }
 
-    add(out, "images: %zu\n", scene.images.size());
+    const size_t skipped = static_cast<size_t>(
+        std::count_if(scene.images.begin(), scene.images.end(),
+                      [](const raster::Image& image) { return !image.decoded; }));
+    add(out, "images: %zu", scene.images.size());
+    if (skipped > 0)
+        add(out, " (%zu not decoded: no shading mode samples them)", skipped);
+    out += "\n";
     for (size_t i = 0; i < scene.images.size(); ++i) {
         const raster::Image& image = scene.images[i];
-        if (image.levels.empty()) {
-            add(out, "  image %zu%s: no pixels\n", i, quoted(image.name).c_str());
-            continue;
-        }
-        add(out, "  image %zu%s: %ux%u, %zu mip levels, %s\n", i, quoted(image.name).c_str(),
-            image.levels[0].width, image.levels[0].height, image.levels.size(),
-            image.srgb ? "sRGB" : "linear");
+        add(out, "  image %zu%s: ", i, quoted(image.name).c_str());
+        if (!image.decoded)
+            out += "not decoded";
+        else if (image.levels.empty())
+            out += "no pixels";
+        else
+            add(out, "%ux%u, %zu mip levels, %s", image.levels[0].width, image.levels[0].height,
+                image.levels.size(), image.srgb ? "sRGB" : "linear");
+        out += rolesText(image.roles);
+        out += "\n";
     }
 
     add(out, "samplers: %zu\n", scene.samplers.size());

@@ -1,7 +1,10 @@
 // glTF 2.0 import: tinygltf parses the JSON (and GLB container) into its Model; everything read
 // from that Model is validated here and converted into focal's Scene at once. Nothing escapes this
 // file as an exception: tinygltf (nlohmann json) may throw, so the whole import runs under a
-// catch-all that turns any throw into a Status.
+// catch-all that turns any throw into a Status, and each image-decoding task (which may run on a
+// worker thread) catches its own. Only the images the caller's texture roles need are decoded.
+#include "stopwatch.h"
+
 #include <raster/gltf_import.h>
 
 #include <glm/geometric.hpp>
@@ -10,6 +13,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -300,8 +304,9 @@ struct AttributeRule {
 
 class Importer {
 public:
-    Importer(std::string path, tinygltf::Model& model, Scene& scene)
-        : path_(std::move(path)), model_(model), scene_(scene) {}
+    Importer(std::string path, tinygltf::Model& model, Scene& scene, const ImportOptions& options,
+             ImportStats& stats)
+        : path_(std::move(path)), model_(model), scene_(scene), options_(options), stats_(stats) {}
 
     Status run(const CapturedImages& captured);
 
@@ -331,8 +336,8 @@ private:
     tinygltf::Model& model_;
     Scene& scene_;
     bool quantization_ = false;
-    std::vector<bool> image_is_color_; // used as base colour or emissive (sRGB, must decode)
-    std::vector<std::string> image_decode_error_;
+    const ImportOptions& options_;
+    ImportStats& stats_;
 };
 
 Status Importer::checkExtensions() {
@@ -441,108 +446,179 @@ Status Importer::bufferViewBytes(int index, const std::string& what, const unsig
     return {};
 }
 
+// One image on its way from encoded bytes to a mip chain. decodeImage writes only its own slot,
+// so images decode on any worker in any order and the result is the same for any thread count.
+struct ImageSlot {
+    std::string what; // "image 3 (name)", for messages
+    Status fatal;     // a broken file (bytes out of range): reported in image order
+    const unsigned char* bytes = nullptr;
+    size_t size = 0;
+    bool needed = false; // used in a role the caller asked for: decode it
+    std::string problem; // why the image has no pixels; empty when it decoded
+    Image image;
+    double ms_decode = 0.0;
+    double ms_mipmaps = 0.0;
+    const char* thrown = nullptr; // decoding threw (no allocation in the handler): this says what
+};
+
+// Decodes slot.bytes into slot.image (8-bit RGBA, full mip chain), or sets slot.problem.
+// Thread-safe: stb_image keeps its error state per thread, and nothing else is shared.
+void decodeImage(ImageSlot& slot, int index) {
+    // Decode with stb_image (inside libtinygltf), forcing 4 channels (grey, grey-alpha and RGB
+    // are expanded); 16-bit images stay 16-bit and are reduced below.
+    auto t0 = std::chrono::steady_clock::now();
+    tinygltf::Image decoded;
+    std::string err, warn_text;
+    if (!tinygltf::LoadImageData(&decoded, index, &err, &warn_text, 0, 0, slot.bytes,
+                                 static_cast<int>(slot.size), nullptr)) {
+        slot.problem = "cannot be decoded (not a PNG/JPEG/BMP/GIF/TGA/PSD/HDR/PNM image stb can "
+                       "read)";
+        return;
+    }
+    const size_t bytes_per = decoded.bits == 16 ? 2 : 1;
+    size_t texels = 0, expect = 0;
+    if (decoded.width < 1 || decoded.height < 1 || decoded.component != 4 ||
+        (decoded.bits != 8 && decoded.bits != 16) ||
+        !mulSize(static_cast<size_t>(decoded.width), static_cast<size_t>(decoded.height), texels) ||
+        !mulSize(texels, 4 * bytes_per, expect) || decoded.image.size() != expect) {
+        slot.problem = "decoded to an unexpected pixel layout";
+        return;
+    }
+    MipLevel level;
+    level.width = static_cast<uint32_t>(decoded.width);
+    level.height = static_cast<uint32_t>(decoded.height);
+    if (decoded.bits == 8) {
+        level.rgba8 = std::move(decoded.image);
+    } else {
+        // 16 → 8 bit with rounding: v8 = round(v16 * 255 / 65535).
+        level.rgba8.resize(texels * 4);
+        for (size_t k = 0; k < texels * 4; ++k) {
+            uint16_t v;
+            std::memcpy(&v, decoded.image.data() + 2 * k, 2);
+            level.rgba8[k] = static_cast<uint8_t>((uint32_t{v} * 255u + 32767u) / 65535u);
+        }
+    }
+    slot.image.levels.push_back(std::move(level));
+    slot.ms_decode = msSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    buildMipChain(slot.image);
+    slot.ms_mipmaps = msSince(t0);
+}
+
 Status Importer::convertImages(const CapturedImages& captured) {
-    // Which images colour a surface (base colour, emissive): they are sRGB and must decode.
-    image_is_color_.assign(model_.images.size(), false);
-    auto mark = [&](const tinygltf::TextureInfo& info) {
-        if (info.index < 0 || static_cast<size_t>(info.index) >= model_.textures.size())
+    // What each image is used for. Base colour and emissive colour a surface: they are sRGB,
+    // and a needed one that does not decode fails the import.
+    const size_t count = model_.images.size();
+    std::vector<TextureRoles> roles(count);
+    auto mark = [&](int texture, TextureRole role) {
+        if (texture < 0 || static_cast<size_t>(texture) >= model_.textures.size())
             return; // reported by convertMaterials
-        const int source = model_.textures[static_cast<size_t>(info.index)].source;
-        if (source >= 0 && static_cast<size_t>(source) < model_.images.size())
-            image_is_color_[static_cast<size_t>(source)] = true;
+        const int source = model_.textures[static_cast<size_t>(texture)].source;
+        if (source >= 0 && static_cast<size_t>(source) < count)
+            roles[static_cast<size_t>(source)] = roles[static_cast<size_t>(source)] | role;
     };
     for (const tinygltf::Material& m : model_.materials) {
-        mark(m.pbrMetallicRoughness.baseColorTexture);
-        mark(m.emissiveTexture);
+        mark(m.pbrMetallicRoughness.baseColorTexture.index, TextureRole::BaseColor);
+        mark(m.emissiveTexture.index, TextureRole::Emissive);
+        mark(m.pbrMetallicRoughness.metallicRoughnessTexture.index, TextureRole::MetallicRoughness);
+        mark(m.normalTexture.index, TextureRole::Normal);
+        mark(m.occlusionTexture.index, TextureRole::Occlusion);
     }
+    const TextureRoles colour = TextureRoles{} | TextureRole::BaseColor | TextureRole::Emissive;
 
-    image_decode_error_.assign(model_.images.size(), std::string());
-    for (size_t i = 0; i < model_.images.size(); ++i) {
+    // Find the encoded bytes and check what needs no decoding, in image order.
+    std::vector<ImageSlot> slots(count);
+    for (size_t i = 0; i < count; ++i) {
         const tinygltf::Image& in = model_.images[i];
-        std::string what = "image " + std::to_string(i);
+        ImageSlot& slot = slots[i];
+        slot.what = "image " + std::to_string(i);
         if (!in.name.empty())
-            what += " (" + in.name + ")";
+            slot.what += " (" + in.name + ")";
         else if (!in.uri.empty() && !tinygltf::IsDataURI(in.uri))
-            what += " (" + in.uri + ")";
+            slot.what += " (" + in.uri + ")";
+        slot.image.name = in.name.empty() ? in.uri : in.name;
+        if (tinygltf::IsDataURI(slot.image.name))
+            slot.image.name = "image " + std::to_string(i);
+        slot.image.roles = roles[i];
+        slot.image.srgb = roles[i].intersects(colour);
+        slot.needed = !options_.roles || roles[i].intersects(*options_.roles);
 
-        // Find the encoded bytes.
-        const unsigned char* bytes = nullptr;
-        size_t size = 0;
-        std::string problem;
         if (in.bufferView >= 0) {
-            FOCAL_GLTF_TRY(bufferViewBytes(in.bufferView, what, bytes, size));
+            slot.fatal = bufferViewBytes(in.bufferView, slot.what, slot.bytes, slot.size);
+            if (!slot.fatal.ok())
+                continue;
         } else if (i < captured.delivered.size() && captured.delivered[i]) {
-            bytes = captured.bytes[i].data();
-            size = captured.bytes[i].size();
+            slot.bytes = captured.bytes[i].data();
+            slot.size = captured.bytes[i].size();
         } else {
-            problem = "file not found: " + in.uri;
+            slot.problem = "file not found: " + in.uri;
         }
-        if (problem.empty() && size == 0)
-            problem = "is empty";
-        if (problem.empty() && size > static_cast<size_t>(std::numeric_limits<int>::max()))
-            problem = "is too large to decode";
+        if (slot.problem.empty() && slot.size == 0)
+            slot.problem = "is empty";
+        if (slot.problem.empty() &&
+            slot.size > static_cast<size_t>(std::numeric_limits<int>::max()))
+            slot.problem = "is too large to decode";
         uint32_t header_w = 0, header_h = 0;
-        if (problem.empty() && peekImageSize(bytes, size, header_w, header_h) &&
+        if (slot.problem.empty() && peekImageSize(slot.bytes, slot.size, header_w, header_h) &&
             (header_w > kMaxImageSide || header_h > kMaxImageSide ||
              uint64_t{header_w} * header_h > kMaxImagePixels))
-            problem =
+            slot.problem =
                 "is too large (" + std::to_string(header_w) + "x" + std::to_string(header_h) + ")";
+    }
 
-        // Decode with stb_image (inside libtinygltf), forcing 4 channels (grey, grey-alpha and
-        // RGB are expanded); 16-bit images stay 16-bit and are reduced below.
-        tinygltf::Image decoded;
-        if (problem.empty()) {
-            std::string err, warn_text;
-            decoded.name = in.name;
-            if (!tinygltf::LoadImageData(&decoded, static_cast<int>(i), &err, &warn_text, 0, 0,
-                                         bytes, static_cast<int>(size), nullptr))
-                problem = "cannot be decoded (not a PNG/JPEG/BMP/GIF/TGA/PSD/HDR/PNM image stb "
-                          "can read)";
+    // Decode and mipmap the needed images, one image per task.
+    const auto t0 = std::chrono::steady_clock::now();
+    auto decodeOne = [&](uint32_t i, uint32_t) {
+        ImageSlot& slot = slots[i];
+        if (!slot.needed || !slot.fatal.ok() || !slot.problem.empty())
+            return;
+        // Nothing may escape a task (it would end the worker thread): note what was thrown.
+        try {
+            decodeImage(slot, static_cast<int>(i));
+        } catch (const std::bad_alloc&) {
+            slot.thrown = "out of memory while decoding";
+        } catch (...) {
+            slot.thrown = "decoding failed";
         }
-        size_t texels = 0;
-        if (problem.empty()) {
-            const size_t bytes_per = decoded.bits == 16 ? 2 : 1;
-            size_t expect = 0;
-            if (decoded.width < 1 || decoded.height < 1 || decoded.component != 4 ||
-                (decoded.bits != 8 && decoded.bits != 16) ||
-                !mulSize(static_cast<size_t>(decoded.width), static_cast<size_t>(decoded.height),
-                         texels) ||
-                !mulSize(texels, 4 * bytes_per, expect) || decoded.image.size() != expect)
-                problem = "decoded to an unexpected pixel layout";
-        }
+    };
+    const uint32_t count32 = static_cast<uint32_t>(count);
+    if (options_.pool)
+        options_.pool->parallelFor(count32, decodeOne);
+    else
+        for (uint32_t i = 0; i < count32; ++i)
+            decodeOne(i, 0);
+    stats_.ms_images = msSince(t0);
 
-        Image out;
-        out.name = in.name.empty() ? in.uri : in.name;
-        if (tinygltf::IsDataURI(out.name))
-            out.name = "image " + std::to_string(i);
-        out.srgb = image_is_color_[i];
-        MipLevel level;
-        if (!problem.empty()) {
-            if (image_is_color_[i])
-                return fail(what + " " + problem);
+    // Report and keep the results in image order.
+    for (size_t i = 0; i < count; ++i) {
+        ImageSlot& slot = slots[i];
+        if (!slot.fatal.ok())
+            return slot.fatal;
+        if (slot.thrown)
+            return fail(slot.what + " " + slot.thrown);
+        stats_.ms_decode += slot.ms_decode;
+        stats_.ms_mipmaps += slot.ms_mipmaps;
+        Image& out = slot.image;
+        if (!slot.needed) {
+            // Not sampled: left without pixels; what was found without decoding is reported.
+            if (!slot.problem.empty())
+                warn(slot.what + " " + slot.problem + "; not needed, so not decoded");
+            out.decoded = false;
+            ++stats_.images_skipped;
+        } else if (!slot.problem.empty()) {
+            if (out.srgb)
+                return fail(slot.what + " " + slot.problem);
             // Not used for colour: keep a 1x1 white placeholder so indices stay valid.
-            warn(what + " " + problem + "; replaced by a white texel");
-            image_decode_error_[i] = problem;
+            warn(slot.what + " " + slot.problem + "; replaced by a white texel");
+            MipLevel level;
             level.width = 1;
             level.height = 1;
             level.rgba8.assign(4, 255);
+            out.levels.push_back(std::move(level));
         } else {
-            level.width = static_cast<uint32_t>(decoded.width);
-            level.height = static_cast<uint32_t>(decoded.height);
-            if (decoded.bits == 8) {
-                level.rgba8 = std::move(decoded.image);
-            } else {
-                // 16 → 8 bit with rounding: v8 = round(v16 * 255 / 65535).
-                level.rgba8.resize(texels * 4);
-                for (size_t k = 0; k < texels * 4; ++k) {
-                    uint16_t v;
-                    std::memcpy(&v, decoded.image.data() + 2 * k, 2);
-                    level.rgba8[k] = static_cast<uint8_t>((uint32_t{v} * 255u + 32767u) / 65535u);
-                }
-            }
+            ++stats_.images_decoded;
         }
-        out.levels.push_back(std::move(level));
-        buildMipChain(out);
         scene_.images.push_back(std::move(out));
     }
     return {};
@@ -1318,9 +1394,11 @@ Status Importer::run(const CapturedImages& captured) {
     FOCAL_GLTF_TRY(checkExtensions());
     FOCAL_GLTF_TRY(convertSamplers());
     FOCAL_GLTF_TRY(convertImages(captured));
+    const auto t0 = std::chrono::steady_clock::now();
     FOCAL_GLTF_TRY(convertMaterials());
     FOCAL_GLTF_TRY(convertMeshes());
     FOCAL_GLTF_TRY(convertNodes());
+    stats_.ms_scene = msSince(t0);
     if (!model_.animations.empty())
         warn("animations are not supported; the scene is drawn at rest");
 
@@ -1347,7 +1425,9 @@ std::string tinygltfError(const std::string& err) {
     return line;
 }
 
-Result<Scene> importImpl(const std::string& path) {
+Result<Scene> importImpl(const std::string& path, const ImportOptions& options,
+                         ImportStats& stats) {
+    const auto t0 = std::chrono::steady_clock::now();
     // Read the whole file ourselves: precise "not found" messages, and GLB is recognised by its
     // magic rather than its name.
     std::error_code ec;
@@ -1401,7 +1481,8 @@ Result<Scene> importImpl(const std::string& path) {
             continue;
         scene.warnings.push_back("tinygltf: " + line);
     }
-    Importer importer(path, model, scene);
+    stats.ms_parse = msSince(t0);
+    Importer importer(path, model, scene, options, stats);
     Status status = importer.run(captured);
     if (!status.ok())
         return status;
@@ -1421,8 +1502,9 @@ Status oneLine(const Status& status) {
     return Status::error(std::move(message));
 }
 
-Result<Scene> importChecked(const std::string& path) {
-    Result<Scene> result = importImpl(path);
+Result<Scene> importChecked(const std::string& path, const ImportOptions& options,
+                            ImportStats& stats) {
+    Result<Scene> result = importImpl(path, options, stats);
     if (!result.ok())
         return oneLine(result.status());
     return result;
@@ -1430,9 +1512,16 @@ Result<Scene> importChecked(const std::string& path) {
 
 } // namespace
 
-Result<Scene> importGltf(const std::string& path) {
+Result<Scene> importGltf(const std::string& path, const ImportOptions& options,
+                         ImportStats* stats) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ImportStats local;
+    ImportStats& out = stats ? *stats : local;
+    out = ImportStats{};
     try {
-        return importChecked(path);
+        Result<Scene> scene = importChecked(path, options, out);
+        out.ms_total = msSince(t0);
+        return scene;
     } catch (const std::bad_alloc&) {
         return Status::error(path + ": out of memory");
     } catch (const std::exception& e) {

@@ -2,6 +2,7 @@
 #include "geometry.h"
 #include "light_kernel.h"
 #include "sinks.h"
+#include "stopwatch.h"
 #include "tile_raster.h"
 
 #include <raster/renderer.h>
@@ -13,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace raster {
 
@@ -66,16 +68,33 @@ Status validate(const View& view) {
     return {};
 }
 
+Status validateTextures(const Scene& scene, ShadingMode mode) {
+    const TextureRoles sampled = sampledTextureRoles(mode);
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        const std::pair<TextureRole, const TextureRef*> refs[] = {
+            {TextureRole::BaseColor, &m.base_color_texture},
+            {TextureRole::Emissive, &m.emissive_texture}};
+        for (const auto& [role, ref] : refs) {
+            if (!sampled.has(role) || ref->image < 0)
+                continue;
+            if (size_t(ref->image) >= scene.images.size() ||
+                scene.images[size_t(ref->image)].levels.empty())
+                return Status::error("material " + std::to_string(i) + " samples image " +
+                                     std::to_string(ref->image) + " as its " +
+                                     textureRoleName(role) +
+                                     " texture, but the scene has no pixels for it (import "
+                                     "with the texture roles the shading samples)");
+        }
+    }
+    return {};
+}
+
 namespace {
 
 bool hasBlendMaterial(const Scene& scene) {
     return std::any_of(scene.materials.begin(), scene.materials.end(),
                        [](const Material& m) { return m.alpha_mode == AlphaMode::Blend; });
-}
-
-double msSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
 }
 } // namespace
 
@@ -84,6 +103,8 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     if (Status s = validate(options); !s.ok())
         return s;
     if (Status s = validate(view); !s.ok())
+        return s;
+    if (Status s = validateTextures(scene, options.shading); !s.ok())
         return s;
     State& st = *state_;
     auto t0 = std::chrono::steady_clock::now();

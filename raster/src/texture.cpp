@@ -16,6 +16,22 @@ float linearToSrgb(float v) {
     return v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
+const char* textureRoleName(TextureRole role) {
+    switch (role) {
+    case TextureRole::BaseColor:
+        return "base colour";
+    case TextureRole::Emissive:
+        return "emissive";
+    case TextureRole::MetallicRoughness:
+        return "metallic-roughness";
+    case TextureRole::Normal:
+        return "normal";
+    case TextureRole::Occlusion:
+        return "occlusion";
+    }
+    return "unknown";
+}
+
 namespace {
 
 // Decoding table for 8-bit sRGB, built once (thread-safe static initialisation).

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <string>
 
 namespace focal::test {
 
@@ -58,19 +59,46 @@ raster::Frame render(const raster::Scene& scene, const raster::View& view,
     return frame;
 }
 
-uint64_t hashFrame(const raster::Frame& frame) {
+namespace {
+
+// FNV-1a 64, fed byte ranges in order.
+struct Fnv64 {
     uint64_t h = 1469598103934665603ull;
-    auto mix = [&h](const void* data, size_t bytes) {
+    void mix(const void* data, size_t bytes) {
         const auto* p = static_cast<const unsigned char*>(data);
         for (size_t i = 0; i < bytes; ++i) {
             h ^= p[i];
             h *= 1099511628211ull;
         }
-    };
-    mix(frame.color.data(), frame.color.size() * sizeof(float));
-    mix(frame.depth.float32.data(), frame.depth.float32.size() * sizeof(float));
-    mix(frame.depth.unorm16.data(), frame.depth.unorm16.size() * sizeof(uint16_t));
-    return h;
+    }
+    void mix(const std::string& s) { mix(s.data(), s.size() + 1); }
+};
+
+} // namespace
+
+uint64_t hashFrame(const raster::Frame& frame) {
+    Fnv64 f;
+    f.mix(frame.color.data(), frame.color.size() * sizeof(float));
+    f.mix(frame.depth.float32.data(), frame.depth.float32.size() * sizeof(float));
+    f.mix(frame.depth.unorm16.data(), frame.depth.unorm16.size() * sizeof(uint16_t));
+    return f.h;
+}
+
+uint64_t hashImages(const raster::Scene& scene) {
+    Fnv64 f;
+    for (const raster::Image& image : scene.images) {
+        f.mix(image.name);
+        const uint8_t flags[3] = {image.roles.bits, uint8_t(image.decoded), uint8_t(image.srgb)};
+        f.mix(flags, sizeof flags);
+        for (const raster::MipLevel& level : image.levels) {
+            const uint32_t size[2] = {level.width, level.height};
+            f.mix(size, sizeof size);
+            f.mix(level.rgba8.data(), level.rgba8.size());
+        }
+    }
+    for (const std::string& w : scene.warnings)
+        f.mix(w);
+    return f.h;
 }
 
 glm::vec4 pixel(const raster::Frame& frame, uint32_t x, uint32_t y) {

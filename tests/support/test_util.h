@@ -40,6 +40,10 @@ raster::Frame render(const raster::Scene& scene, const raster::View& view,
 // FNV-1a 64 over the colour floats and the stored depth values.
 uint64_t hashFrame(const raster::Frame& frame);
 
+// FNV-1a 64 over every image of the scene (name, roles, decoded, sRGB, each level's size and
+// texels) and the import warnings, in order.
+uint64_t hashImages(const raster::Scene& scene);
+
 glm::vec4 pixel(const raster::Frame& frame, uint32_t x, uint32_t y);
 
 } // namespace focal::test

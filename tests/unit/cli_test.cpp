@@ -336,6 +336,44 @@ TEST_F(Cli, InfoDescribesAGltfFile) {
     EXPECT_TRUE(contains(r.out, "triangles: 2")) << r.out;
 }
 
+TEST_F(Cli, InfoDecodesWhatShadingSamplesAndReportsLoadTime) {
+    // Only the base colour of unsampled_maps.gltf is sampled by any shading mode: its broken
+    // normal map is not decoded unless --all-images asks for every image.
+    const std::string path = dataPath("gltf/valid/unsampled_maps.gltf");
+    const ProcessResult r = focal({"info", path, "--threads", "2"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(contains(r.out, "images: 4 (3 not decoded: no shading mode samples them)"))
+        << r.out;
+    EXPECT_TRUE(contains(r.out, "\"broken_normal\": not decoded, used as metallic-roughness, "
+                                "normal\n"))
+        << r.out;
+    EXPECT_TRUE(contains(r.out, "load: ")) << r.out;
+    EXPECT_TRUE(contains(r.out, "1 images decoded, 3 skipped")) << r.out;
+
+    const ProcessResult all = focal({"info", path, "--all-images", "--threads", "0"});
+    EXPECT_EQ(all.exit_code, 0) << all.err;
+    EXPECT_TRUE(contains(all.out, "images: 4\n")) << all.out;
+    EXPECT_TRUE(contains(all.out, "image 1 (broken_normal) cannot be decoded")) << all.out;
+    EXPECT_TRUE(contains(all.out, "2 images decoded, 0 skipped")) << all.out;
+}
+
+TEST_F(Cli, RenderStatsReportTheLoad) {
+    const ProcessResult r =
+        focal({"render", dataPath("gltf/valid/unsampled_maps.gltf"), "-o", "out.exr", "--stats",
+               "s.json", "--width", "16", "--height", "16", "--shading", "lit"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(dir_ / "s.json");
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    ASSERT_FALSE(j.is_discarded()) << "s.json is not valid JSON";
+    ASSERT_TRUE(j.contains("load")) << j.dump(2);
+    const nlohmann::json& load = j["load"];
+    for (const char* key : {"total", "parse", "images", "decode", "mipmaps", "scene"})
+        EXPECT_TRUE(load["time_ms"][key].is_number()) << key << " " << load.dump(2);
+    EXPECT_EQ(load.value("images_decoded", -1), 1) << load.dump(2);
+    EXPECT_EQ(load.value("images_skipped", -1), 3) << load.dump(2);
+    EXPECT_TRUE(j["time_ms"]["total"].is_number()) << j.dump(2);
+}
+
 TEST_F(Cli, InfoOfAMissingFileFailsWithOneLine) {
     const ProcessResult r = focal({"info", "missing.glb"});
     EXPECT_TRUE(failedWithOneErrorLine(r, 1));

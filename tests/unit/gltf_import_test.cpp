@@ -1,8 +1,12 @@
 // Tests for raster/gltf_import.h: the valid fixtures in tests/data/gltf/valid import with the
 // expected values; every malformed fixture in tests/data/gltf/bad fails with its own message.
 // Fixtures are written by tests/data/gltf/make_fixtures.py.
+#include "support/test_util.h"
+
 #include <raster/gltf_import.h>
+#include <raster/renderer.h>
 #include <raster/scene.h>
+#include <raster/task_pool.h>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -270,6 +274,147 @@ TEST(GltfImport, BinaryGlbWithImageInBufferView) {
     EXPECT_EQ(scene.images[0].levels[0].rgba8[0], 255u);
     EXPECT_TRUE(scene.images[0].srgb);
     EXPECT_EQ(scene.materials.at(0).base_color_texture.image, 0);
+}
+
+// --- load only what is sampled (issue 18) ---------------------------------------------------
+
+constexpr raster::ShadingMode kShadingModes[] = {
+    raster::ShadingMode::Material, raster::ShadingMode::Unlit, raster::ShadingMode::Lit};
+
+raster::ImportOptions sampledBy(raster::ShadingMode mode, raster::TaskPool* pool = nullptr) {
+    raster::ImportOptions options;
+    options.roles = raster::sampledTextureRoles(mode);
+    options.pool = pool;
+    return options;
+}
+
+TEST(GltfImportSampled, NoShadingModeSamplesNormalOcclusionOrMetallicRoughnessMaps) {
+    for (const raster::ShadingMode mode : kShadingModes) {
+        const raster::TextureRoles roles = raster::sampledTextureRoles(mode);
+        EXPECT_TRUE(roles.has(raster::TextureRole::BaseColor));
+        EXPECT_TRUE(roles.has(raster::TextureRole::Emissive));
+        EXPECT_FALSE(roles.has(raster::TextureRole::Normal));
+        EXPECT_FALSE(roles.has(raster::TextureRole::Occlusion));
+        EXPECT_FALSE(roles.has(raster::TextureRole::MetallicRoughness));
+    }
+}
+
+TEST(GltfImportSampled, UnsampledMapsAreNotDecodedForAnyShadingMode) {
+    for (const raster::ShadingMode mode : kShadingModes) {
+        raster::ImportStats stats;
+        auto result = importGltf(validPath("unsampled_maps.gltf"), sampledBy(mode), &stats);
+        ASSERT_TRUE(result.ok()) << result.status().message();
+        const Scene& scene = *result;
+        ASSERT_EQ(scene.images.size(), 4u);
+        const raster::Image& checker = scene.images[0];
+        EXPECT_TRUE(checker.decoded);
+        ASSERT_EQ(checker.levels.size(), 2u);
+        EXPECT_EQ(checker.levels[0].width, 2u);
+        EXPECT_EQ(checker.roles, raster::TextureRoles{} | raster::TextureRole::BaseColor);
+        // The undecodable normal map is never decoded, so it is no problem.
+        const raster::Image& normal = scene.images[1];
+        EXPECT_FALSE(normal.decoded);
+        EXPECT_TRUE(normal.levels.empty());
+        EXPECT_EQ(normal.roles, raster::TextureRoles{} | raster::TextureRole::MetallicRoughness |
+                                    raster::TextureRole::Normal);
+        EXPECT_FALSE(scene.images[2].decoded);
+        EXPECT_EQ(scene.images[2].roles, raster::TextureRoles{} | raster::TextureRole::Occlusion);
+        EXPECT_FALSE(scene.images[3].decoded);
+        EXPECT_TRUE(scene.images[3].roles.empty());
+        // A missing file is found without decoding: still reported, as a warning.
+        ASSERT_EQ(scene.warnings.size(), 1u);
+        EXPECT_EQ(scene.warnings[0], "image 2 (missing_occlusion.png) file not found: "
+                                     "missing_occlusion.png; not needed, so not decoded");
+        EXPECT_EQ(stats.images_decoded, 1u);
+        EXPECT_EQ(stats.images_skipped, 3u);
+        EXPECT_GE(stats.ms_total, stats.ms_parse);
+    }
+}
+
+TEST(GltfImportSampled, EveryImageIsDecodedByDefaultAndWhenItsRoleIsAskedFor) {
+    // Unset roles decode every image, as before: the broken normal map is a warning and a white
+    // texel, the image no material uses is decoded too.
+    raster::ImportStats stats;
+    auto all = importGltf(validPath("unsampled_maps.gltf"), {}, &stats);
+    ASSERT_TRUE(all.ok()) << all.status().message();
+    ASSERT_EQ(all->images.size(), 4u);
+    for (const raster::Image& image : all->images) {
+        EXPECT_TRUE(image.decoded) << image.name;
+        EXPECT_FALSE(image.levels.empty()) << image.name;
+    }
+    EXPECT_EQ(all->images[1].levels[0].rgba8, (std::vector<uint8_t>{255, 255, 255, 255}));
+    EXPECT_EQ(all->images[3].levels[0].width, 2u);
+    EXPECT_TRUE(hasWarning(*all, "image 1 (broken_normal) cannot be decoded"));
+    EXPECT_TRUE(hasWarning(*all, "image 1 (broken_normal) cannot be decoded (not a "
+                                 "PNG/JPEG/BMP/GIF/TGA/PSD/HDR/PNM image stb can read); replaced "
+                                 "by a white texel"));
+    EXPECT_TRUE(hasWarning(*all, "image 2 (missing_occlusion.png) file not found: "
+                                 "missing_occlusion.png; replaced by a white texel"));
+    EXPECT_EQ(stats.images_decoded, 2u); // the two placeholders are not counted as decoded
+    EXPECT_EQ(stats.images_skipped, 0u);
+
+    // Asking for normal maps decodes (and reports) exactly the broken one.
+    raster::ImportOptions normals;
+    normals.roles = raster::TextureRoles{} | raster::TextureRole::Normal;
+    auto with_normals = importGltf(validPath("unsampled_maps.gltf"), normals);
+    ASSERT_TRUE(with_normals.ok()) << with_normals.status().message();
+    EXPECT_FALSE(with_normals->images[0].decoded);
+    EXPECT_TRUE(with_normals->images[1].decoded);
+    EXPECT_TRUE(hasWarning(*with_normals, "image 1 (broken_normal) cannot be decoded"));
+}
+
+TEST(GltfImportSampled, UndecodableBaseColourStillFailsForEveryShadingMode) {
+    for (const raster::ShadingMode mode : kShadingModes) {
+        auto result = importGltf(badPath("undecodable_image.gltf"), sampledBy(mode));
+        ASSERT_FALSE(result.ok());
+        EXPECT_NE(result.status().message().find("image 0 cannot be decoded"), std::string::npos)
+            << result.status().message();
+    }
+}
+
+TEST(GltfImportSampled, SameImagesAndWarningsForEveryThreadCount) {
+    for (const char* name : {"textured_quad.gltf", "unsampled_maps.gltf", "triangle.glb"}) {
+        for (const bool sampled : {false, true}) {
+            raster::ImportOptions options =
+                sampled ? sampledBy(raster::ShadingMode::Material) : raster::ImportOptions{};
+            auto inline_result = importGltf(validPath(name), options);
+            ASSERT_TRUE(inline_result.ok()) << inline_result.status().message();
+            const uint64_t reference = focal::test::hashImages(*inline_result);
+            for (const uint32_t threads : {0u, 1u, 2u, 5u}) {
+                raster::TaskPool pool(threads);
+                options.pool = &pool;
+                auto result = importGltf(validPath(name), options);
+                ASSERT_TRUE(result.ok()) << result.status().message();
+                EXPECT_EQ(focal::test::hashImages(*result), reference)
+                    << name << " threads " << threads << (sampled ? " sampled" : " all");
+            }
+        }
+    }
+}
+
+TEST(GltfImportSampled, RenderRefusesATextureImportDidNotDecode) {
+    raster::ImportOptions none;
+    none.roles = raster::TextureRoles{};
+    auto result = importGltf(validPath("textured_quad.gltf"), none);
+    ASSERT_TRUE(result.ok()) << result.status().message();
+    for (const raster::ShadingMode mode : kShadingModes) {
+        const raster::Status s = raster::validateTextures(*result, mode);
+        ASSERT_FALSE(s.ok());
+        EXPECT_EQ(s.message(), "material 0 samples image 0 as its base colour texture, but the "
+                               "scene has no pixels for it (import with the texture roles the "
+                               "shading samples)");
+    }
+    raster::TaskPool pool(0);
+    raster::Renderer renderer(pool);
+    raster::Frame frame;
+    EXPECT_FALSE(renderer.render(*result, focal::test::pixelView(8, 8, 8.0f), {}, frame).ok());
+
+    auto sampled =
+        importGltf(validPath("textured_quad.gltf"), sampledBy(raster::ShadingMode::Unlit));
+    ASSERT_TRUE(sampled.ok()) << sampled.status().message();
+    EXPECT_FALSE(sampled->images[1].decoded); // the 16-bit normal map
+    for (const raster::ShadingMode mode : kShadingModes)
+        EXPECT_TRUE(raster::validateTextures(*sampled, mode).ok());
 }
 
 TEST(GltfImport, MissingFile) {

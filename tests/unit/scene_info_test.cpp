@@ -105,6 +105,25 @@ TEST(SceneInfo, EmptySceneSaysSo) {
     EXPECT_TRUE(contains(text, "warnings: 0\n")) << text;
 }
 
+TEST(SceneInfo, SaysWhichImagesWereNotDecodedAndWhatTheyAreFor) {
+    raster::ImportOptions options;
+    options.roles = raster::TextureRoles{} | raster::TextureRole::BaseColor;
+    raster::ImportStats stats;
+    auto scene = raster::importGltf(
+        std::string(FOCAL_TEST_DATA_DIR) + "/gltf/valid/textured_quad.gltf", options, &stats);
+    ASSERT_TRUE(scene.ok()) << scene.status().message();
+    const std::string text = focal::describeScene(*scene);
+    EXPECT_TRUE(contains(text, "images: 3 (2 not decoded: no shading mode samples them)\n"))
+        << text;
+    EXPECT_TRUE(contains(text, "image 0 \"checker\": 2x2, 2 mip levels, sRGB, used as base "
+                               "colour\n"))
+        << text;
+    EXPECT_TRUE(contains(text, "image 1 \"grey16\": not decoded, used as normal\n")) << text;
+    const std::string load = focal::describeLoad(stats);
+    EXPECT_TRUE(contains(load, "load: ")) << load;
+    EXPECT_TRUE(contains(load, "1 images decoded, 2 skipped")) << load;
+}
+
 TEST(SceneInfo, DescribesAnImportedFile) {
     auto scene =
         raster::importGltf(std::string(FOCAL_TEST_DATA_DIR) + "/gltf/valid/textured_quad.gltf");

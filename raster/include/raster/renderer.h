@@ -24,6 +24,11 @@ enum class ShadingMode : uint8_t {
     Lit,      // Lambert + Blinn-Phong for every material
 };
 
+// The texture roles shading in `mode` can sample: the images a scene must have decoded for it
+// (ImportOptions::roles). Every mode reads base colour (colour and alpha) and emissive; lighting
+// uses the metallic and roughness factors, never a metallic-roughness, normal or occlusion map.
+TextureRoles sampledTextureRoles(ShadingMode mode);
+
 struct RenderOptions {
     uint32_t tile_size = 64; // pixels, a multiple of 8 in [8, 256]
     DepthFormat depth_format = DepthFormat::Float32;
@@ -60,7 +65,8 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     // Renders `scene` seen through `view` into `out` (resized to view.width x view.height).
-    // Fails only on invalid options or views; never on scene content.
+    // Fails only on invalid options or views, or when a material's texture in a role the
+    // shading samples has no pixels (an image import skipped); never on other scene content.
     Status render(const Scene& scene, const View& view, const RenderOptions& options, Frame& out,
                   FrameStats* stats = nullptr);
 
@@ -93,5 +99,7 @@ constexpr uint32_t kMaxLayers = 64;
 // Validates options the user can set (tile size range, etc.).
 Status validate(const RenderOptions& options);
 Status validate(const View& view);
+// Checks that every image a material samples under `mode` was decoded (Image::decoded).
+Status validateTextures(const Scene& scene, ShadingMode mode);
 
 } // namespace raster

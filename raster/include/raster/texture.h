@@ -32,10 +32,36 @@ struct MipLevel {
     std::vector<uint8_t> rgba8; // width*height*4, row 0 is the top row (glTF uv (0,0))
 };
 
+// What a material samples a texture for (glTF 2.0 §3.9.2-3.9.5).
+enum class TextureRole : uint8_t { BaseColor, Emissive, MetallicRoughness, Normal, Occlusion };
+constexpr uint32_t kTextureRoleCount = 5;
+
+// A set of texture roles, one bit per TextureRole.
+struct TextureRoles {
+    uint8_t bits = 0;
+
+    static constexpr TextureRoles all() { return {uint8_t((1u << kTextureRoleCount) - 1)}; }
+    constexpr bool has(TextureRole role) const { return (bits >> uint32_t(role)) & 1u; }
+    constexpr bool empty() const { return bits == 0; }
+    constexpr TextureRoles operator|(TextureRole role) const {
+        return {uint8_t(bits | (1u << uint32_t(role)))};
+    }
+    constexpr bool intersects(TextureRoles other) const { return (bits & other.bits) != 0; }
+    constexpr bool operator==(const TextureRoles&) const = default;
+};
+
+// "base colour", "emissive", "metallic-roughness", "normal", "occlusion".
+const char* textureRoleName(TextureRole role);
+
 struct Image {
     std::string name;
     bool srgb = true;             // colour channels sRGB-encoded (base colour, emissive)
     std::vector<MipLevel> levels; // levels[0] is the full image; buildMipChain adds the rest
+    // What the scene's materials use the image for (glTF import; empty for built-in scenes).
+    TextureRoles roles;
+    // False when import skipped the image because none of its roles was asked for
+    // (ImportOptions::roles): `levels` is then empty and nothing may sample it.
+    bool decoded = true;
 };
 
 // Replaces image.levels[1..] with the full chain down to 1x1: each texel of level i+1 is the

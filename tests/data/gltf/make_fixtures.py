@@ -290,6 +290,23 @@ def make_valid():
     doc = g.finish(uri="")
     write_glb(VALID, "triangle.glb", doc, g.bin)
 
+    # unsampled_maps.gltf: a base colour that decodes; a normal map that does not, an occlusion
+    # map whose file is missing, and an image no material uses. focal's shading samples none of
+    # the last three, so importing for any shading mode decodes only the base colour.
+    g = triangle_doc()
+    g.doc["meshes"][0]["primitives"][0]["material"] = 0
+    g.doc["images"] = [{"name": "checker", "uri": data_uri(PNG_RGB, "image/png")},
+                       {"name": "broken_normal",
+                        "uri": data_uri(b"\x89PNG\r\n\x1a\nnot really a png", "image/png")},
+                       {"uri": "missing_occlusion.png"},
+                       {"name": "unused", "uri": data_uri(PNG_RGB, "image/png")}]
+    g.doc["textures"] = [{"source": 0}, {"source": 1}, {"source": 2}, {"source": 3}]
+    g.doc["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+                                                    "metallicRoughnessTexture": {"index": 1}},
+                           "normalTexture": {"index": 1},
+                           "occlusionTexture": {"index": 2}}]
+    write_json(VALID, "unsampled_maps.gltf", g.finish())
+
 
 # --- malformed fixtures ----------------------------------------------------------------------
 
