@@ -978,10 +978,15 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                 RayState* pr = rays + p * n;
                 MultiviewRayRecord* recs =
                     isDebugPixel(tr, x, y) ? tr.settings->debug_rays->data() : nullptr;
+                uint32_t live = 0;
                 for (uint32_t k = 0; k < n; ++k)
-                    if (pr[k].transmit > 0.0f)
+                    if (pr[k].transmit > 0.0f) {
                         traceLayer(tr, x, y, l, hittable, k, pr[k], recs ? recs + k : nullptr,
                                    cnt);
+                        live += pr[k].transmit > 0.0f ? 1 : 0;
+                    }
+                if (live == 0)
+                    pixel_layers[p].active = 0; // every ray has ended: no layer behind is met
             }
     }
     for (uint32_t y = y0; y < y1; ++y)
