@@ -60,6 +60,23 @@ void appendCylinder(raster::Primitive& prim, glm::vec3 a, glm::vec3 b, float ra,
 void appendTorus(raster::Primitive& prim, glm::vec3 center, float major_radius, float minor_radius,
                  uint32_t major_segments, uint32_t minor_segments);
 
+// A flat gear of `teeth` trapezoidal teeth around a round bore, centred on the origin in the xy
+// plane (front face +Z, thickness along Z; place it with an instance matrix). Flat-shaded.
+void appendGear(raster::Primitive& prim, uint32_t teeth, float root_radius, float tip_radius,
+                float bore_radius, float thickness);
+
+// A zero-thickness sheet in the xy plane (z = 0, facing +Z; give it a double-sided material) of
+// nx x ny square cells of side `pitch`, from `origin` (lower-left corner) towards +X and +Y, each
+// with a round hole of `hole_radius` (< pitch / 2) drawn as an octagon. Cells share their edges
+// bit for bit, so the sheet is watertight.
+void appendPerforatedPlate(raster::Primitive& prim, glm::vec3 origin, uint32_t nx, uint32_t ny,
+                           float pitch, float hole_radius);
+
+// A leaf quad: stem at `base`, blade of length `size` along `along`, half as wide along
+// `across`, facing cross(across, along).
+void appendLeaf(raster::Primitive& prim, glm::vec3 base, glm::vec3 along, glm::vec3 across,
+                float size, glm::vec4 tint);
+
 // Fills prim.colors with `color` for every vertex from `first_vertex` on (creating the array,
 // white-filled, if it was empty).
 void paintVertices(raster::Primitive& prim, uint32_t first_vertex, glm::vec4 color);

@@ -22,17 +22,6 @@ struct Bush {
     uint32_t leaves;
 };
 
-// Appends one leaf quad: stem at `base`, blade along `along`, facing `normal`-ish.
-void appendLeaf(raster::Primitive& prim, glm::vec3 base, glm::vec3 along, glm::vec3 across,
-                float size, glm::vec4 tint) {
-    const uint32_t first = static_cast<uint32_t>(prim.positions.size());
-    const glm::vec3 half_w = 0.5f * size * across;
-    const glm::vec3 len = size * along;
-    appendQuad(prim, base - half_w, base + half_w, base + half_w + len, base - half_w + len,
-               glm::normalize(glm::cross(across, along)));
-    paintVertices(prim, first, tint);
-}
-
 void appendBush(raster::Primitive& leaves, raster::Primitive& stems, const Bush& bush,
                 uint32_t seed) {
     for (uint32_t i = 0; i < bush.leaves; ++i) {
