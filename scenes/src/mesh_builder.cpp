@@ -339,6 +339,13 @@ int32_t addSampler(raster::Scene& scene, raster::Sampler sampler) {
     return static_cast<int32_t>(scene.samplers.size() - 1);
 }
 
+int32_t addClampedSampler(raster::Scene& scene) {
+    raster::Sampler clamp;
+    clamp.wrap_s = raster::Wrap::ClampToEdge;
+    clamp.wrap_t = raster::Wrap::ClampToEdge;
+    return addSampler(scene, clamp);
+}
+
 uint32_t addMesh(raster::Scene& scene, std::string name, raster::Primitive prim) {
     raster::Mesh mesh;
     mesh.name = std::move(name);
@@ -365,6 +372,14 @@ raster::Material textured(std::string name, int32_t image, int32_t sampler, floa
     m.base_color_texture.image = image;
     m.base_color_texture.sampler = sampler;
     return m;
+}
+
+raster::Material maskedLeaf(int32_t image, int32_t sampler) {
+    raster::Material leaf = textured("leaf", image, sampler, 0.7f);
+    leaf.alpha_mode = raster::AlphaMode::Mask;
+    leaf.alpha_cutoff = 0.5f;
+    leaf.double_sided = true;
+    return leaf;
 }
 
 raster::Camera lookAtCamera(std::string name, glm::vec3 eye, glm::vec3 target, float yfov,

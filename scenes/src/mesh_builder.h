@@ -87,6 +87,8 @@ int32_t addMaterial(raster::Scene& scene, raster::Material material);
 // Adds the image after building its mip chain.
 int32_t addImage(raster::Scene& scene, raster::Image image);
 int32_t addSampler(raster::Scene& scene, raster::Sampler sampler);
+// A sampler with the default (linear, mipmapped) filters that clamps s and t to the edge.
+int32_t addClampedSampler(raster::Scene& scene);
 // A one-primitive mesh; `prim.material` must already be set.
 uint32_t addMesh(raster::Scene& scene, std::string name, raster::Primitive prim);
 void addInstance(raster::Scene& scene, uint32_t mesh, const glm::mat4& world = glm::mat4(1.0f));
@@ -94,6 +96,8 @@ void addInstance(raster::Scene& scene, uint32_t mesh, const glm::mat4& world = g
 // Common materials (linear colours; metallic 0 unless said otherwise).
 raster::Material matte(std::string name, glm::vec3 color, float roughness = 0.8f);
 raster::Material textured(std::string name, int32_t image, int32_t sampler, float roughness = 0.8f);
+// A leaf cut out of `image` by its alpha (MASK, cutoff 0.5), double-sided, roughness 0.7.
+raster::Material maskedLeaf(int32_t image, int32_t sampler);
 
 // A glTF camera at `eye` looking at `target` (its world matrix maps -Z to the view axis).
 raster::Camera lookAtCamera(std::string name, glm::vec3 eye, glm::vec3 target, float yfov,

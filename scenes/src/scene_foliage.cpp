@@ -61,10 +61,7 @@ raster::Scene makeFoliageScene() {
     raster::Scene scene;
     scene.background = {0.6f, 0.74f, 0.9f};
     const int32_t repeat = addSampler(scene, {});
-    raster::Sampler clamp;
-    clamp.wrap_s = raster::Wrap::ClampToEdge;
-    clamp.wrap_t = raster::Wrap::ClampToEdge;
-    const int32_t clamped = addSampler(scene, clamp);
+    const int32_t clamped = addClampedSampler(scene);
 
     const glm::vec3 eye{0.0f, 1.15f, 0.0f};
     const glm::vec3 target{0.0f, 1.0f, -3.5f};
@@ -72,11 +69,7 @@ raster::Scene makeFoliageScene() {
 
     // Leaves: one MASK material (alpha cut-off 0.5), double-sided, tinted per leaf by COLOR_0.
     const int32_t leaf_tex = addImage(scene, leafImage(256));
-    raster::Material leaf = textured("leaf", leaf_tex, clamped, 0.7f);
-    leaf.alpha_mode = raster::AlphaMode::Mask;
-    leaf.alpha_cutoff = 0.5f;
-    leaf.double_sided = true;
-    const int32_t leaf_mat = addMaterial(scene, std::move(leaf));
+    const int32_t leaf_mat = addMaterial(scene, maskedLeaf(leaf_tex, clamped));
     const int32_t stem_mat = addMaterial(scene, matte("stem", {0.2f, 0.13f, 0.07f}, 0.9f));
 
     // Near bushes frame the view (0.7-1.6 m, strongly blurred), mid bushes flank the statue,

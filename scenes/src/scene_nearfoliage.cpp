@@ -51,10 +51,7 @@ raster::Scene makeNearFoliageScene() {
     raster::Scene scene;
     scene.background = {0.6f, 0.72f, 0.88f};
     const int32_t repeat = addSampler(scene, {});
-    raster::Sampler clamp;
-    clamp.wrap_s = raster::Wrap::ClampToEdge;
-    clamp.wrap_t = raster::Wrap::ClampToEdge;
-    const int32_t clamped = addSampler(scene, clamp);
+    const int32_t clamped = addClampedSampler(scene);
 
     const glm::vec3 eye{0.0f, 1.2f, 0.0f};
     scene.cameras.push_back(
@@ -103,11 +100,7 @@ raster::Scene makeNearFoliageScene() {
     // Near sprigs: from the top left (0.3-0.45 m), from the right (0.55-0.8 m) and up from the
     // bottom (0.6-1 m).
     const int32_t leaf_tex = addImage(scene, leafImage(256));
-    raster::Material leaf = textured("leaf", leaf_tex, clamped, 0.7f);
-    leaf.alpha_mode = raster::AlphaMode::Mask;
-    leaf.alpha_cutoff = 0.5f;
-    leaf.double_sided = true;
-    const int32_t leaf_mat = addMaterial(scene, std::move(leaf));
+    const int32_t leaf_mat = addMaterial(scene, maskedLeaf(leaf_tex, clamped));
     const int32_t twig_mat = addMaterial(scene, matte("twig", {0.22f, 0.15f, 0.08f}, 0.9f));
     constexpr std::array<Sprig, 3> kSprigs = {{
         {{-0.22f, 1.42f, -0.3f}, {-0.02f, 1.24f, -0.45f}, {0.2f, 0.3f, 1.0f}, 0.055f, 5},

@@ -17,10 +17,7 @@ raster::Scene makeNearSurfaceScene() {
     raster::Scene scene;
     scene.background = {0.5f, 0.55f, 0.6f};
     const int32_t repeat = addSampler(scene, {});
-    raster::Sampler clamp;
-    clamp.wrap_s = raster::Wrap::ClampToEdge;
-    clamp.wrap_t = raster::Wrap::ClampToEdge;
-    const int32_t clamped = addSampler(scene, clamp);
+    const int32_t clamped = addClampedSampler(scene);
 
     // Camera at the origin looking down -Z; yfov 0.8 rad gives f_px = 709 at 800 x 600.
     scene.cameras.push_back(
