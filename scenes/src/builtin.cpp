@@ -14,7 +14,7 @@ struct Entry {
     raster::Scene (*make)();
 };
 
-constexpr std::array<Entry, 8> kEntries = {{
+constexpr std::array<Entry, 11> kEntries = {{
     {{"demo", "the overview: checker ground, objects at several depths (textured, coloured, "
               "emissive) and a thin out-of-focus railing in front of in-focus detail"},
      detail::makeDemoScene},
@@ -39,6 +39,15 @@ constexpr std::array<Entry, 8> kEntries = {{
     {{"reflective", "view-dependent shading: shiny metallic spheres of varying roughness under "
                     "point lights (Lee, Eisemann & Seidel 2009, Sec. 5)"},
      detail::makeReflectiveScene},
+    {{"nearsurface", "a large smooth shaded machine part 0.17-0.34 m from the lens, blurred "
+                     "17-40 px over an in-focus brick wall and sign"},
+     detail::makeNearSurfaceScene},
+    {{"nearfoliage", "large alpha-masked (MASK) leaves 0.3-1 m from the lens, blurred up to "
+                     "50 px over an in-focus wall, sign and sphere"},
+     detail::makeNearFoliageScene},
+    {{"perforated", "thin machined parts: a perforated grill blurred 25 px in front, gears with "
+                    "thin teeth in front of, at and behind the focal plane"},
+     detail::makePerforatedScene},
 }};
 
 constexpr std::array<BuiltinInfo, kEntries.size()> makeInfos() {

@@ -14,5 +14,8 @@ raster::Scene makeFoliageScene();
 raster::Scene makeGlassScene();
 raster::Scene makeDenseScene();
 raster::Scene makeReflectiveScene();
+raster::Scene makeNearSurfaceScene();
+raster::Scene makeNearFoliageScene();
+raster::Scene makePerforatedScene();
 
 } // namespace scenes::detail

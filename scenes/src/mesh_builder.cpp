@@ -231,6 +231,91 @@ void appendTorus(raster::Primitive& prim, glm::vec3 center, float major_radius, 
     pushLattice(prim, base, minor_segments, major_segments);
 }
 
+void appendGear(raster::Primitive& prim, uint32_t teeth, float root_radius, float tip_radius,
+                float bore_radius, float thickness) {
+    FOCAL_CHECK(teeth >= 3 && bore_radius > 0.0f && bore_radius < root_radius &&
+                root_radius < tip_radius && thickness > 0.0f);
+    // Per tooth four profile points: root, tip, tip, root at these fractions of its pitch; the
+    // root arc runs from 0.8 to the next tooth's 0.
+    constexpr float kProfile[4] = {0.0f, 0.3f, 0.5f, 0.8f};
+    const uint32_t n = 4 * teeth;
+    std::vector<glm::vec2> outer(n), inner(n);
+    for (uint32_t i = 0; i < n; ++i) {
+        const float angle =
+            2.0f * kPi * (static_cast<float>(i / 4) + kProfile[i % 4]) / static_cast<float>(teeth);
+        const glm::vec2 dir{cosf64(angle), sinf64(angle)};
+        const bool tip = i % 4 == 1 || i % 4 == 2;
+        outer[i] = (tip ? tip_radius : root_radius) * dir;
+        inner[i] = bore_radius * dir;
+    }
+    const float h = 0.5f * thickness;
+    auto at = [](glm::vec2 p, float z) { return glm::vec3(p, z); };
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t j = (i + 1) % n;
+        // Faces: annular sectors, counter-clockwise seen from +Z (front) and -Z (back).
+        appendQuad(prim, at(inner[i], h), at(outer[i], h), at(outer[j], h), at(inner[j], h),
+                   {0.0f, 0.0f, 1.0f});
+        appendQuad(prim, at(inner[j], -h), at(outer[j], -h), at(outer[i], -h), at(inner[i], -h),
+                   {0.0f, 0.0f, -1.0f});
+        // Outer wall (normal away from the axis) and bore wall (normal towards it).
+        const glm::vec2 d = outer[j] - outer[i];
+        const glm::vec3 out_n = glm::normalize(glm::vec3(d.y, -d.x, 0.0f));
+        appendQuad(prim, at(outer[i], -h), at(outer[j], -h), at(outer[j], h), at(outer[i], h),
+                   out_n);
+        const glm::vec2 e = inner[j] - inner[i];
+        const glm::vec3 in_n = glm::normalize(glm::vec3(-e.y, e.x, 0.0f));
+        appendQuad(prim, at(inner[j], -h), at(inner[i], -h), at(inner[i], h), at(inner[j], h),
+                   in_n);
+    }
+}
+
+void appendPerforatedPlate(raster::Primitive& prim, glm::vec3 origin, uint32_t nx, uint32_t ny,
+                           float pitch, float hole_radius) {
+    FOCAL_CHECK(nx >= 1 && ny >= 1 && hole_radius > 0.0f && hole_radius < 0.5f * pitch);
+    // 8 directions from a cell's centre, 45 degrees apart: on the cell's square they land on
+    // its corners and the middles of its edges.
+    constexpr uint32_t kSegments = 8;
+    constexpr float kSquare[kSegments][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1},
+                                             {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+    const glm::vec3 normal{0.0f, 0.0f, 1.0f};
+    for (uint32_t cy = 0; cy < ny; ++cy) {
+        for (uint32_t cx = 0; cx < nx; ++cx) {
+            // Edges from the grid lines, so neighbouring cells compute the same coordinates.
+            const float x0 = origin.x + pitch * static_cast<float>(cx);
+            const float x1 = origin.x + pitch * static_cast<float>(cx + 1);
+            const float y0 = origin.y + pitch * static_cast<float>(cy);
+            const float y1 = origin.y + pitch * static_cast<float>(cy + 1);
+            const float xc = origin.x + pitch * (static_cast<float>(cx) + 0.5f);
+            const float yc = origin.y + pitch * (static_cast<float>(cy) + 0.5f);
+            auto onSquare = [&](uint32_t k) {
+                const float ux = kSquare[k][0], uy = kSquare[k][1];
+                const float x = ux > 0.0f ? x1 : ux < 0.0f ? x0 : xc;
+                const float y = uy > 0.0f ? y1 : uy < 0.0f ? y0 : yc;
+                return glm::vec3(x, y, origin.z);
+            };
+            auto onHole = [&](uint32_t k) {
+                const float angle = 2.0f * kPi * fraction(k, kSegments);
+                return glm::vec3(xc + hole_radius * cosf64(angle), yc + hole_radius * sinf64(angle),
+                                 origin.z);
+            };
+            for (uint32_t k = 0; k < kSegments; ++k) {
+                const uint32_t k1 = (k + 1) % kSegments;
+                appendQuad(prim, onHole(k), onSquare(k), onSquare(k1), onHole(k1), normal);
+            }
+        }
+    }
+}
+
+void appendLeaf(raster::Primitive& prim, glm::vec3 base, glm::vec3 along, glm::vec3 across,
+                float size, glm::vec4 tint) {
+    const uint32_t first = vertexCount(prim);
+    const glm::vec3 half_w = 0.5f * size * across;
+    const glm::vec3 len = size * along;
+    appendQuad(prim, base - half_w, base + half_w, base + half_w + len, base - half_w + len,
+               glm::normalize(glm::cross(across, along)));
+    paintVertices(prim, first, tint);
+}
+
 void paintVertices(raster::Primitive& prim, uint32_t first_vertex, glm::vec4 color) {
     if (prim.colors.empty())
         prim.colors.assign(prim.positions.size(), glm::vec4(1.0f));
@@ -252,6 +337,13 @@ int32_t addImage(raster::Scene& scene, raster::Image image) {
 int32_t addSampler(raster::Scene& scene, raster::Sampler sampler) {
     scene.samplers.push_back(sampler);
     return static_cast<int32_t>(scene.samplers.size() - 1);
+}
+
+int32_t addClampedSampler(raster::Scene& scene) {
+    raster::Sampler clamp;
+    clamp.wrap_s = raster::Wrap::ClampToEdge;
+    clamp.wrap_t = raster::Wrap::ClampToEdge;
+    return addSampler(scene, clamp);
 }
 
 uint32_t addMesh(raster::Scene& scene, std::string name, raster::Primitive prim) {
@@ -280,6 +372,14 @@ raster::Material textured(std::string name, int32_t image, int32_t sampler, floa
     m.base_color_texture.image = image;
     m.base_color_texture.sampler = sampler;
     return m;
+}
+
+raster::Material maskedLeaf(int32_t image, int32_t sampler) {
+    raster::Material leaf = textured("leaf", image, sampler, 0.7f);
+    leaf.alpha_mode = raster::AlphaMode::Mask;
+    leaf.alpha_cutoff = 0.5f;
+    leaf.double_sided = true;
+    return leaf;
 }
 
 raster::Camera lookAtCamera(std::string name, glm::vec3 eye, glm::vec3 target, float yfov,

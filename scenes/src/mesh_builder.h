@@ -60,6 +60,23 @@ void appendCylinder(raster::Primitive& prim, glm::vec3 a, glm::vec3 b, float ra,
 void appendTorus(raster::Primitive& prim, glm::vec3 center, float major_radius, float minor_radius,
                  uint32_t major_segments, uint32_t minor_segments);
 
+// A flat gear of `teeth` trapezoidal teeth around a round bore, centred on the origin in the xy
+// plane (front face +Z, thickness along Z; place it with an instance matrix). Flat-shaded.
+void appendGear(raster::Primitive& prim, uint32_t teeth, float root_radius, float tip_radius,
+                float bore_radius, float thickness);
+
+// A zero-thickness sheet in the xy plane (z = 0, facing +Z; give it a double-sided material) of
+// nx x ny square cells of side `pitch`, from `origin` (lower-left corner) towards +X and +Y, each
+// with a round hole of `hole_radius` (< pitch / 2) drawn as an octagon. Cells share their edges
+// bit for bit, so the sheet is watertight.
+void appendPerforatedPlate(raster::Primitive& prim, glm::vec3 origin, uint32_t nx, uint32_t ny,
+                           float pitch, float hole_radius);
+
+// A leaf quad: stem at `base`, blade of length `size` along `along`, half as wide along
+// `across`, facing cross(across, along).
+void appendLeaf(raster::Primitive& prim, glm::vec3 base, glm::vec3 along, glm::vec3 across,
+                float size, glm::vec4 tint);
+
 // Fills prim.colors with `color` for every vertex from `first_vertex` on (creating the array,
 // white-filled, if it was empty).
 void paintVertices(raster::Primitive& prim, uint32_t first_vertex, glm::vec4 color);
@@ -70,6 +87,8 @@ int32_t addMaterial(raster::Scene& scene, raster::Material material);
 // Adds the image after building its mip chain.
 int32_t addImage(raster::Scene& scene, raster::Image image);
 int32_t addSampler(raster::Scene& scene, raster::Sampler sampler);
+// A sampler with the default (linear, mipmapped) filters that clamps s and t to the edge.
+int32_t addClampedSampler(raster::Scene& scene);
 // A one-primitive mesh; `prim.material` must already be set.
 uint32_t addMesh(raster::Scene& scene, std::string name, raster::Primitive prim);
 void addInstance(raster::Scene& scene, uint32_t mesh, const glm::mat4& world = glm::mat4(1.0f));
@@ -77,6 +96,8 @@ void addInstance(raster::Scene& scene, uint32_t mesh, const glm::mat4& world = g
 // Common materials (linear colours; metallic 0 unless said otherwise).
 raster::Material matte(std::string name, glm::vec3 color, float roughness = 0.8f);
 raster::Material textured(std::string name, int32_t image, int32_t sampler, float roughness = 0.8f);
+// A leaf cut out of `image` by its alpha (MASK, cutoff 0.5), double-sided, roughness 0.7.
+raster::Material maskedLeaf(int32_t image, int32_t sampler);
 
 // A glTF camera at `eye` looking at `target` (its world matrix maps -Z to the view axis).
 raster::Camera lookAtCamera(std::string name, glm::vec3 eye, glm::vec3 target, float yfov,

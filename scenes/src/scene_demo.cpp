@@ -16,10 +16,7 @@ raster::Scene makeDemoScene() {
     scene.background = {0.52f, 0.66f, 0.88f};
 
     const int32_t repeat = addSampler(scene, {});
-    raster::Sampler clamp;
-    clamp.wrap_s = raster::Wrap::ClampToEdge;
-    clamp.wrap_t = raster::Wrap::ClampToEdge;
-    const int32_t clamped = addSampler(scene, clamp);
+    const int32_t clamped = addClampedSampler(scene);
 
     const glm::vec3 eye{0.0f, 1.15f, 5.5f};
     const glm::vec3 target{0.0f, 0.7f, 0.0f};

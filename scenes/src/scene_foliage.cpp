@@ -22,17 +22,6 @@ struct Bush {
     uint32_t leaves;
 };
 
-// Appends one leaf quad: stem at `base`, blade along `along`, facing `normal`-ish.
-void appendLeaf(raster::Primitive& prim, glm::vec3 base, glm::vec3 along, glm::vec3 across,
-                float size, glm::vec4 tint) {
-    const uint32_t first = static_cast<uint32_t>(prim.positions.size());
-    const glm::vec3 half_w = 0.5f * size * across;
-    const glm::vec3 len = size * along;
-    appendQuad(prim, base - half_w, base + half_w, base + half_w + len, base - half_w + len,
-               glm::normalize(glm::cross(across, along)));
-    paintVertices(prim, first, tint);
-}
-
 void appendBush(raster::Primitive& leaves, raster::Primitive& stems, const Bush& bush,
                 uint32_t seed) {
     for (uint32_t i = 0; i < bush.leaves; ++i) {
@@ -72,10 +61,7 @@ raster::Scene makeFoliageScene() {
     raster::Scene scene;
     scene.background = {0.6f, 0.74f, 0.9f};
     const int32_t repeat = addSampler(scene, {});
-    raster::Sampler clamp;
-    clamp.wrap_s = raster::Wrap::ClampToEdge;
-    clamp.wrap_t = raster::Wrap::ClampToEdge;
-    const int32_t clamped = addSampler(scene, clamp);
+    const int32_t clamped = addClampedSampler(scene);
 
     const glm::vec3 eye{0.0f, 1.15f, 0.0f};
     const glm::vec3 target{0.0f, 1.0f, -3.5f};
@@ -83,11 +69,7 @@ raster::Scene makeFoliageScene() {
 
     // Leaves: one MASK material (alpha cut-off 0.5), double-sided, tinted per leaf by COLOR_0.
     const int32_t leaf_tex = addImage(scene, leafImage(256));
-    raster::Material leaf = textured("leaf", leaf_tex, clamped, 0.7f);
-    leaf.alpha_mode = raster::AlphaMode::Mask;
-    leaf.alpha_cutoff = 0.5f;
-    leaf.double_sided = true;
-    const int32_t leaf_mat = addMaterial(scene, std::move(leaf));
+    const int32_t leaf_mat = addMaterial(scene, maskedLeaf(leaf_tex, clamped));
     const int32_t stem_mat = addMaterial(scene, matte("stem", {0.2f, 0.13f, 0.07f}, 0.9f));
 
     // Near bushes frame the view (0.7-1.6 m, strongly blurred), mid bushes flank the statue,

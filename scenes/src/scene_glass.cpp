@@ -16,10 +16,7 @@ raster::Scene makeGlassScene() {
     raster::Scene scene;
     scene.background = {0.5f, 0.6f, 0.75f};
     const int32_t repeat = addSampler(scene, {});
-    raster::Sampler clamp;
-    clamp.wrap_s = raster::Wrap::ClampToEdge;
-    clamp.wrap_t = raster::Wrap::ClampToEdge;
-    const int32_t clamped = addSampler(scene, clamp);
+    const int32_t clamped = addClampedSampler(scene);
 
     const glm::vec3 eye{0.0f, 1.4f, 0.0f};
     const glm::vec3 target{0.0f, 1.1f, -3.5f};

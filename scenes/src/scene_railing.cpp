@@ -14,10 +14,7 @@ raster::Scene makeRailingScene() {
     scene.background = {0.55f, 0.68f, 0.85f};
 
     const int32_t repeat = addSampler(scene, {});
-    raster::Sampler clamp;
-    clamp.wrap_s = raster::Wrap::ClampToEdge;
-    clamp.wrap_t = raster::Wrap::ClampToEdge;
-    const int32_t clamped = addSampler(scene, clamp);
+    const int32_t clamped = addClampedSampler(scene);
 
     // Camera: eye height 1.2 m looking horizontally at the sign 4 m away.
     const glm::vec3 eye{0.0f, 1.2f, 0.0f};

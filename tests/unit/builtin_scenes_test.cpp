@@ -115,8 +115,9 @@ uint64_t sceneHash(const Scene& scene) {
 }
 
 TEST(BuiltinScenes, ListHasFixedOrderAndDescriptions) {
-    const std::vector<std::string> expected = {"demo",    "railing", "branches", "bokeh",
-                                               "foliage", "glass",   "dense",    "reflective"};
+    const std::vector<std::string> expected = {
+        "demo",  "railing",    "branches",    "bokeh",       "foliage",   "glass",
+        "dense", "reflective", "nearsurface", "nearfoliage", "perforated"};
     std::span<const scenes::BuiltinInfo> list = scenes::builtinScenes();
     ASSERT_EQ(list.size(), expected.size());
     for (size_t i = 0; i < list.size(); ++i) {

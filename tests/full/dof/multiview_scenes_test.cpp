@@ -5,6 +5,7 @@
 // beats view-independent shading on shiny spheres; cell-centred cones keep the bokeh's rims; the
 // defaults that differ from the paper are the closer ones.
 #include "../../unit/dof/dof_test_util.h"
+#include "method_runs.h"
 #include "support/builtin_case.h"
 
 #include <dof/metrics.h>
@@ -20,23 +21,7 @@ namespace {
 
 std::vector<float> multiview(const BuiltinCase& c, const dof::LensSampleSet& samples,
                              const dof::MultiviewSettings& s, raster::Frame* pinhole = nullptr) {
-    raster::TaskPool pool(2);
-    raster::Renderer renderer(pool);
-    raster::RenderOptions options;
-    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
-        return renderer.render(c.scene, v, options, f);
-    };
-    const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                  raster::LayeredTarget& t) {
-        return renderer.renderLayers(c.scene, v, options, d, t);
-    };
-    dof::ShadingInputs shading;
-    shading.scene = &c.scene;
-    std::vector<float> rgba;
-    raster::Result<dof::MultiviewStats> r = dof::renderMultiview(
-        c.view, c.lens, samples, s, shading, c.scene.background, pin, lay, pool, rgba, pinhole);
-    FOCAL_CHECK(r.ok());
-    return rgba;
+    return runMultiview(c, samples, s, pinhole);
 }
 
 dof::ErrorMetrics compare(const std::vector<float>& a, const raster::Frame& ref,
