@@ -102,19 +102,6 @@ struct TileCounters {
              transparent_hits = 0, layer_steps = 0;
 };
 
-// One lens ray between the layers of its pixel (traceTile traces a tile layer by layer, so each
-// ray's state waits here while the other rays of the tile meet the same layer).
-struct RayState {
-    LensSample lens;       // jittered lens position (§4.5) and weight
-    glm::vec2 w{0.0f};     // image offset per unit C (lensRayImageOffset)
-    glm::vec2 wc{0.0f};    // where its cones are centred, per unit C (ConeCentre)
-    glm::vec3 color{0.0f}; // what it has seen so far
-    float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4); 0: ended
-    float t_resume = -1.0f;
-    float t_end = 0.0f;
-    bool discarded = false; // its path starts outside the image (OffscreenPolicy::Discard)
-};
-
 // Everything the per-pixel loop reads; built once per frame.
 struct Tracer {
     const raster::View* view = nullptr;
@@ -138,8 +125,6 @@ struct Tracer {
     // ConeCentre::Cell: per sample, its cone centre's image offset per unit C relative to the
     // ray's (the cell offset with x negated, as lensRayImageOffset); empty: cones on the rays.
     std::vector<glm::vec2> cone_offsets;
-    // JitterMode::None: ray k's state at the start of every pixel (beginPixel copies it).
-    std::vector<RayState> ray_starts;
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     glm::vec3 background{0.0f};
 
@@ -664,6 +649,18 @@ RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<
     return p;
 }
 
+// One lens ray between the layers of its pixel (traceTile traces a tile layer by layer, so each
+// ray's state waits here while the other rays of the tile meet the same layer).
+struct RayState {
+    LensSample lens;       // jittered lens position (§4.5) and weight
+    glm::vec2 w{0.0f};     // image offset per unit C (lensRayImageOffset)
+    glm::vec2 wc{0.0f};    // where its cones are centred, per unit C (ConeCentre)
+    glm::vec3 color{0.0f}; // what it has seen so far
+    float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4); 0: ended
+    float t_resume = -1.0f;
+    float t_end = 0.0f;
+    bool discarded = false; // its path starts outside the image (OffscreenPolicy::Discard)
+};
 
 // The layers a pixel's rays can meet, as bit masks over layer indices.
 struct PixelLayers {
@@ -686,16 +683,6 @@ bool rayInside(const Tracer& tr, uint32_t x, uint32_t y, glm::vec2 w, float t) {
     const glm::vec2 o = tr.offsetOf(w, t);
     return o.x >= -float(x) && o.y >= -float(y) && o.x < float(tr.width - x) &&
            o.y < float(tr.height - y);
-}
-
-// Ray k's state before its first layer, from its lens sample.
-RayState rayStart(const Tracer& tr, uint32_t k, const LensSample& lens) {
-    RayState ray;
-    ray.lens = lens;
-    ray.w = glm::vec2(-lens.position.x, lens.position.y); // lensRayImageOffset per unit C
-    ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
-    ray.t_end = tr.segs.back().t1;
-    return ray;
 }
 
 // Early culling per pixel (§4.3) and the start of each of its rays.
@@ -727,11 +714,14 @@ PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t*
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
     if (isDebugPixel(tr, x, y))
         s.debug_rays->assign(n, MultiviewRayRecord{});
-    cnt.rays += n;
     for (uint32_t k = 0; k < n; ++k) {
+        ++cnt.rays;
         RayState& ray = rays[k];
-        ray = tr.ray_starts.empty() ? rayStart(tr, k, jitteredSample(tr, x, y, k, noise, halton_offset))
-                                    : tr.ray_starts[k];
+        ray = RayState{};
+        ray.lens = jitteredSample(tr, x, y, k, noise, halton_offset);
+        ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
+        ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
+        ray.t_end = tr.segs.back().t1;
         MultiviewRayRecord* rec = recordOf(tr, x, y, k);
         if (rec) {
             rec->lens = ray.lens.position;
@@ -762,7 +752,7 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
     const glm::vec2 w = ray.w, wc = ray.wc;
     // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
     const glm::vec3 shade_from =
-        shade && s.view_dependent
+        s.view_dependent
             ? view.eye + tr.lens->aperture_radius *
                              (ray.lens.position.x * view.right + ray.lens.position.y * view.up)
             : view.eye;
@@ -1490,9 +1480,6 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             stats.path_cells = tr.cells.size();
         }
     }
-    if (settings.jitter == JitterMode::None)
-        for (uint32_t k = 0; k < samples.size(); ++k)
-            tr.ray_starts.push_back(rayStart(tr, k, samples.sample(k)));
     rgba.assign(pixels * 4, 0.0f);
     const uint32_t ts = settings.tile_size;
     const uint32_t tiles_x = (width + ts - 1) / ts, tiles_y = (height + ts - 1) / ts;
