@@ -246,10 +246,13 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     std::vector<float> row_min(height, std::numeric_limits<float>::infinity());
     std::vector<float> row_max(height, 0.0f);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
+        float lo = row_min[y], hi = row_max[y]; // stored once: neighbouring rows share lines
         for (const LayerFragment& f : levels_[0].rows[y]) {
-            row_min[y] = std::min(row_min[y], f.depth);
-            row_max[y] = std::max(row_max[y], f.depth);
+            lo = std::min(lo, f.depth);
+            hi = std::max(hi, f.depth);
         }
+        row_min[y] = lo;
+        row_max[y] = hi;
     });
     float max_coc = 0.0f;
     for (uint32_t y = 0; y < height; ++y)
@@ -351,6 +354,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
         Cursor cursors[2][kMaxTraversalLevels][4];
         uint32_t cursor_count[2][kMaxTraversalLevels];
+        uint64_t slices = 0; // stored once: neighbouring rows' counts share cache lines
         for (uint32_t x = 0; x < width; ++x) {
             const size_t p = size_t(y) * width + x;
             // Bilinear taps of every level at the pixel centre (zero weights skipped).
@@ -433,7 +437,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                     const float sa = part[0][3] + part[1][3];
                     if (!(sa > 0.0f))
                         continue;
-                    ++row_slices[y];
+                    ++slices;
                     // Front-to-back blending of the slice (§6.1): additive within a group of
                     // slices (disjoint pieces of one layer, §7), the over operator between
                     // groups (layers at clearly different depths, whose holes the lens sees
@@ -472,6 +476,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                 bg[2] = rest * background.b, bg[3] = rest;
             }
         }
+        row_slices[y] = slices;
     });
     const double ms_accumulate = msSince(t0);
 

@@ -54,13 +54,18 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
             return !plan.truncate || !truncatedAt(borders, border_level, d);
         };
         ListRef src[kMaxMergeLists];
+        // Counted on the stack and stored once: neighbouring rows' counts share cache lines.
+        uint32_t row_longest = 0;
+        uint64_t row_dropped = 0;
         for (uint32_t i = 0; i < out.width; ++i) {
             const uint32_t count = sources(i, j, src);
             starts[i] = uint32_t(row.size());
-            mergeLists(src, count, plan.epsilon, plan.mean_depth, keep, row, dropped[j]);
-            longest[j] = std::max(longest[j], uint32_t(row.size()) - starts[i]);
+            mergeLists(src, count, plan.epsilon, plan.mean_depth, keep, row, row_dropped);
+            row_longest = std::max(row_longest, uint32_t(row.size()) - starts[i]);
         }
         starts[out.width] = uint32_t(row.size());
+        longest[j] = row_longest;
+        dropped[j] = row_dropped;
     });
     sumRows(longest, dropped, out);
 }
@@ -186,6 +191,7 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
         std::vector<LayerFragment>& row = out.rows[y];
         row.clear();
         uint32_t* starts = out.starts.data() + size_t(y) * (lists.width + 1);
+        uint32_t row_longest = 0; // stored once (see mergeCells)
         for (uint32_t x = 0; x < lists.width; ++x) {
             const size_t p = size_t(y) * lists.width + x;
             starts[x] = uint32_t(row.size());
@@ -197,9 +203,10 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
                 const float a = std::min(c.a, 1.0f);
                 row.push_back({a * c.r, a * c.g, a * c.b, a, d});
             }
-            longest[y] = std::max(longest[y], uint32_t(row.size()) - starts[x]);
+            row_longest = std::max(row_longest, uint32_t(row.size()) - starts[x]);
         }
         starts[lists.width] = uint32_t(row.size());
+        longest[y] = row_longest;
     });
     sumRows(longest, std::vector<uint64_t>(lists.height, 0), out);
 }

@@ -1488,7 +1488,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     std::vector<RayState> ray_states(size_t(pool.workerCount()) * ts * ts * samples.size());
     std::vector<PixelLayers> pixel_layers(size_t(pool.workerCount()) * ts * ts);
     pool.parallelFor(tiles_x * tiles_y, [&](uint32_t tile, uint32_t worker) {
-        TileCounters& cnt = counters[tile];
+        // Counted on the stack, stored once: neighbouring tiles' counters share cache lines,
+        // and the two workers usually trace neighbouring tiles.
+        TileCounters cnt;
         const uint32_t x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
         const uint32_t x1 = std::min(x0 + ts, width), y1 = std::min(y0 + ts, height);
         // Skip empty layers, and layers with nothing in reach of the whole tile (one query).
@@ -1506,6 +1508,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         traceTile(tr, x0, x1, y0, y1, tile_layers.data(), count,
                   ray_states.data() + size_t(worker) * ts * ts * samples.size(),
                   pixel_layers.data() + size_t(worker) * ts * ts, rgba.data(), cnt);
+        counters[tile] = cnt;
     });
     for (const TileCounters& c : counters) {
         stats.rays += c.rays;

@@ -218,6 +218,9 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
         const Primitive& prim = ctx.shade.scene->meshes[draw.mesh].primitives[draw.primitive];
         return materialOf(*ctx.shade.scene, prim).alpha_mode == AlphaMode::Blend;
     };
+    // Counted on the stack and added once: neighbouring tiles' counters share cache lines, and
+    // the workers usually raster neighbouring tiles (false sharing on every fragment).
+    TileCounters local;
     const int passes = ctx.blend_last ? 2 : 1;
     for (int pass = 0; pass < passes; ++pass)
         for (size_t c = 0; c < geo.chunks.size(); ++c) {
@@ -227,9 +230,12 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
                 const SetupTri& t = chunk.tris[bins.items[i]];
                 if (ctx.blend_last && isBlend(t) != (pass == 1))
                     continue;
-                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, sink, counters);
+                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, sink, local);
             }
         }
+    counters.covered += local.covered;
+    counters.passed += local.passed;
+    counters.rejected += local.rejected;
 }
 
 template void rasterizeTile<FrameSink>(const RasterContext&, uint32_t, FrameSink&, TileCounters&);
