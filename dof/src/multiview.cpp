@@ -31,10 +31,9 @@ constexpr int kOwnedChannels = 5;
 // Most mip levels built for cone tracing (a 256-pixel cone diameter).
 constexpr uint32_t kMaxMipLevels = 8;
 // 1 / 2^level: image positions to a level's texels.
-constexpr std::array<float, kMaxMipLevels> kMipScale = {1.0f,       0.5f,        0.25f,
-                                                        0.125f,     0.0625f,     0.03125f,
-                                                        0.015625f,  0.0078125f};
-// Most cells walked in advance (RayPath; 16 bytes each).
+constexpr std::array<float, kMaxMipLevels> kMipScale = {1.0f,    0.5f,     0.25f,     0.125f,
+                                                        0.0625f, 0.03125f, 0.015625f, 0.0078125f};
+// Most cells walked in advance (PathCell; 20 bytes each).
 constexpr double kMaxPathCells = double(1u << 22);
 // Largest image offset a ray may reach (pixels): beyond it the lens is rejected as absurd for the
 // view (offsets are then still exact in float and fit RayPath's int32 boxes).
@@ -359,8 +358,7 @@ Hit scanPath(const Tracer& tr, const float* depth, float seg_near, float s1, uin
 MipLevel mipLevelFor(const Tracer& tr, float diameter) {
     const uint32_t top = uint32_t(tr.scratch->mip_width.size()) - 1;
     // log2(1) = 0: windows up to a pixel read level 0 without the logarithm.
-    const float level =
-        diameter > 1.0f ? std::clamp(std::log2(diameter), 0.0f, float(top)) : 0.0f;
+    const float level = diameter > 1.0f ? std::clamp(std::log2(diameter), 0.0f, float(top)) : 0.0f;
     const uint32_t l0 = uint32_t(level);
     return {l0, std::min(l0 + 1, top), level - float(l0)};
 }
@@ -642,7 +640,8 @@ RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<
     p.box_y0 = int32_t(box.y0), p.box_y1 = int32_t(box.y1);
     p.first = uint32_t(cells.size());
     walkCells(o0, o1, s0, s1, [&](int64_t dx, int64_t dy, float t_in, float t_out) {
-        cells.push_back({int32_t(dx), int32_t(dy), int32_t(dy * int64_t(tr.width) + dx), t_in, t_out});
+        cells.push_back(
+            {int32_t(dx), int32_t(dy), int32_t(dy * int64_t(tr.width) + dx), t_in, t_out});
         return false;
     });
     p.count = uint32_t(cells.size()) - p.first;
@@ -668,14 +667,15 @@ struct PixelLayers {
     uint64_t hittable = 0; // its rays can hit it at all (else only the cones see it)
 };
 
-bool isDebugPixel(const Tracer& tr, uint32_t x, uint32_t y) {
+// The records of pixel (x, y)'s rays in sample order when it is the debug pixel, else null.
+// beginPixel sizes them (`size` rays) before anything is recorded; the others pass 0.
+MultiviewRayRecord* debugRecords(const Tracer& tr, uint32_t x, uint32_t y, uint32_t size = 0) {
     const MultiviewSettings& s = *tr.settings;
-    return s.debug_rays && x == s.debug_x && y == s.debug_y;
-}
-
-// The record of ray k of pixel (x, y), when it is the debug pixel (beginPixel sized them).
-MultiviewRayRecord* recordOf(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k) {
-    return isDebugPixel(tr, x, y) ? &(*tr.settings->debug_rays)[k] : nullptr;
+    if (!s.debug_rays || x != s.debug_x || y != s.debug_y)
+        return nullptr;
+    if (size > 0)
+        s.debug_rays->assign(size, MultiviewRayRecord{});
+    return s.debug_rays->data();
 }
 
 // Whether pixel (x, y)'s ray with offset w lies in the image at stored depth t.
@@ -712,8 +712,7 @@ PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t*
     const uint32_t n = tr.samples->size();
     const float t_first = tr.segs.front().t0;
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
-    if (isDebugPixel(tr, x, y))
-        s.debug_rays->assign(n, MultiviewRayRecord{});
+    MultiviewRayRecord* records = debugRecords(tr, x, y, n);
     for (uint32_t k = 0; k < n; ++k) {
         ++cnt.rays;
         RayState& ray = rays[k];
@@ -722,7 +721,7 @@ PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t*
         ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
         ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
         ray.t_end = tr.segs.back().t1;
-        MultiviewRayRecord* rec = recordOf(tr, x, y, k);
+        MultiviewRayRecord* rec = records ? records + k : nullptr;
         if (rec) {
             rec->lens = ray.lens.position;
             rec->weight = ray.lens.weight;
@@ -752,10 +751,9 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
     const glm::vec2 w = ray.w, wc = ray.wc;
     // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
     const glm::vec3 shade_from =
-        s.view_dependent
-            ? view.eye + tr.lens->aperture_radius *
-                             (ray.lens.position.x * view.right + ray.lens.position.y * view.up)
-            : view.eye;
+        s.view_dependent ? view.eye + tr.lens->aperture_radius * (ray.lens.position.x * view.right +
+                                                                  ray.lens.position.y * view.up)
+                         : view.eye;
     // §4.4: a cone of coverage v1 and colour c1 gives v1 c1 + (1 - v1) c2, c2 what the rest
     // of the ray sees; from kFullCoverage on it blocks the ray (returns true).
     auto blend = [&](float v1, glm::vec3 c1) {
@@ -829,11 +827,11 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
         if (ht.hit && ray.transmit > 0.0f) {
             ++cnt.transparent_hits;
             const float ct = tr.cocOf(ht.t);
-            const glm::vec4 m = s.cone && tr.lambda * std::fabs(ct) > 1.0f
-                                    ? sampleCone(tr, tr.scratch->transparent_mips[l],
-                                                 cx + ct * wc.x, cy + ct * wc.y,
-                                                 tr.lambda * std::fabs(ct))
-                                    : lt.transparent_color.load(lt.index(l, ht.texel));
+            const glm::vec4 m =
+                s.cone && tr.lambda * std::fabs(ct) > 1.0f
+                    ? sampleCone(tr, tr.scratch->transparent_mips[l], cx + ct * wc.x,
+                                 cy + ct * wc.y, tr.lambda * std::fabs(ct))
+                    : lt.transparent_color.load(lt.index(l, ht.texel));
             glm::vec3 rgb(m);
             const size_t ti = lt.index(l, ht.texel);
             if (shade && lt.transparent_top_alpha[ti] > 0.0f) {
@@ -898,13 +896,14 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
     const float t_last = tr.segs.back().t1;
     double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
+    MultiviewRayRecord* records = debugRecords(tr, x, y);
     for (uint32_t k = 0; k < tr.samples->size(); ++k) {
         const RayState& ray = rays[k];
         if (ray.discarded)
             continue;
         glm::vec3 color = ray.color;
         float t_end = ray.t_end;
-        MultiviewRayRecord* rec = recordOf(tr, x, y, k);
+        MultiviewRayRecord* rec = records ? records + k : nullptr;
         if (ray.transmit > 0.0f) {
             ++cnt.background;
             color += ray.transmit * tr.background;
@@ -966,13 +965,11 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                     continue;
                 const bool hittable = (pixel_layers[p].hittable >> l) & 1;
                 RayState* pr = rays + p * n;
-                MultiviewRayRecord* recs =
-                    isDebugPixel(tr, x, y) ? tr.settings->debug_rays->data() : nullptr;
+                MultiviewRayRecord* recs = debugRecords(tr, x, y);
                 uint32_t live = 0;
                 for (uint32_t k = 0; k < n; ++k)
                     if (pr[k].transmit > 0.0f) {
-                        traceLayer(tr, x, y, l, hittable, k, pr[k], recs ? recs + k : nullptr,
-                                   cnt);
+                        traceLayer(tr, x, y, l, hittable, k, pr[k], recs ? recs + k : nullptr, cnt);
                         live += pr[k].transmit > 0.0f ? 1 : 0;
                     }
                 if (live == 0)

@@ -176,7 +176,7 @@ struct MultiviewStats {
     uint64_t rays = 0;               // lens rays traced (pixels x N)
     uint64_t rays_discarded = 0;     // left the image (OffscreenPolicy::Discard)
     uint64_t rays_background = 0;    // passed every layer without a hit
-    uint64_t layer_steps = 0;        // (ray, layer) pairs visited (tracing time / this: ns per step)
+    uint64_t layer_steps = 0;        // (ray, layer) pairs visited
     uint64_t layer_tests = 0;        // ray-segment/height-field tests run
     uint64_t layer_culled_pixel = 0; // (pixel, layer) pairs skipped by the N-buffer query
     uint64_t layer_culled_tile = 0;  // (tile, layer) pairs skipped by one query for the tile
