@@ -418,14 +418,9 @@ int runRender(const RenderArgs& args) {
     import_options.roles = raster::sampledTextureRoles(options.shading);
     import_options.pool = &pool;
     raster::ImportStats load_stats;
-    const auto load_start = std::chrono::steady_clock::now();
     Result<raster::Scene> scene = loadScene(args.scene, import_options, &load_stats);
     if (!scene.ok())
         return fail(scene.status().message());
-    // Reported apart from time_ms: the runs time the render only (docs/benchmarks.md).
-    const double load_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start)
-            .count();
     for (const std::string& w : scene->warnings)
         std::fprintf(stderr, "focal: warning: %s\n", w.c_str());
     Result<raster::View> view = resolveView(*scene, args);
@@ -700,7 +695,6 @@ int runRender(const RenderArgs& args) {
         j["shading"] = args.shading;
         j["texture_filter"] = args.texture_filter;
         j["repeat"] = args.repeat;
-        j["load_ms"] = load_ms;
         j["camera"] = {{"eye", {v.eye.x, v.eye.y, v.eye.z}},
                        {"forward", {v.forward.x, v.forward.y, v.forward.z}},
                        {"up", {v.up.x, v.up.y, v.up.z}},

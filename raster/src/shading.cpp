@@ -30,17 +30,10 @@ glm::vec4 sampleRef(const ShadeContext& ctx, const TextureRef& ref, const UvFoot
 
 } // namespace
 
-TextureRoles sampledTextureRoles(ShadingMode mode) {
-    // baseColor() and emissiveColor() are the only texture reads; unlit and lit shading both
-    // make them (lighting takes metallic and roughness from the material's factors alone).
-    const TextureRoles colour = TextureRoles{} | TextureRole::BaseColor | TextureRole::Emissive;
-    switch (mode) {
-    case ShadingMode::Material:
-    case ShadingMode::Unlit:
-    case ShadingMode::Lit:
-        return colour;
-    }
-    return TextureRoles::all();
+TextureRoles sampledTextureRoles(ShadingMode) {
+    // baseColor() and emissiveColor() are the only texture reads, and every mode makes them
+    // (lighting takes metallic and roughness from the material's factors alone).
+    return TextureRoles{} | TextureRole::BaseColor | TextureRole::Emissive;
 }
 
 glm::vec4 baseColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
