@@ -118,6 +118,8 @@ TEST_F(BenchQuick, WritesParsableResults) {
             << "duplicate row " << key << " " << row["setting"];
         EXPECT_GE(row["ms_max"].get<double>(), row["ms_min"].get<double>());
         EXPECT_GT(row["peak_rss_mib"].get<double>(), 0.0);
+        // The scene load, from the render's --stats (a built-in scene is generated: > 0 ms).
+        EXPECT_GT(row["load_ms"].get<double>(), 0.0) << key;
         // Only accum with the reference's own settings may match it exactly (null PSNR).
         if (row["method"] != "accum") {
             ASSERT_TRUE(row["psnr_srgb_db"].is_number()) << key;
