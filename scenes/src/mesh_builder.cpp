@@ -346,6 +346,16 @@ int32_t addClampedSampler(raster::Scene& scene) {
     return addSampler(scene, clamp);
 }
 
+void addSign(raster::Scene& scene, std::string mesh_name, raster::Image image, int32_t sampler,
+             float roughness, glm::vec2 lo, glm::vec2 hi, float z) {
+    const int32_t texture = addImage(scene, std::move(image));
+    raster::Primitive quad;
+    quad.material = addMaterial(scene, textured("sign", texture, sampler, roughness));
+    appendQuad(quad, {lo.x, lo.y, z}, {hi.x, lo.y, z}, {hi.x, hi.y, z}, {lo.x, hi.y, z},
+               {0.0f, 0.0f, 1.0f});
+    addInstance(scene, addMesh(scene, std::move(mesh_name), std::move(quad)));
+}
+
 uint32_t addMesh(raster::Scene& scene, std::string name, raster::Primitive prim) {
     raster::Mesh mesh;
     mesh.name = std::move(name);

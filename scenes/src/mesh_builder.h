@@ -92,6 +92,10 @@ int32_t addClampedSampler(raster::Scene& scene);
 // A one-primitive mesh; `prim.material` must already be set.
 uint32_t addMesh(raster::Scene& scene, std::string name, raster::Primitive prim);
 void addInstance(raster::Scene& scene, uint32_t mesh, const glm::mat4& world = glm::mat4(1.0f));
+// A sign facing +z: `image` on the rectangle [lo, hi] (x, y) at depth z with a "sign" material
+// (`sampler`, `roughness`), added as image, material, mesh `mesh_name` and one instance.
+void addSign(raster::Scene& scene, std::string mesh_name, raster::Image image, int32_t sampler,
+             float roughness, glm::vec2 lo, glm::vec2 hi, float z);
 
 // Common materials (linear colours; metallic 0 unless said otherwise).
 raster::Material matte(std::string name, glm::vec3 color, float roughness = 0.8f);

@@ -85,13 +85,8 @@ raster::Scene makeDemoScene() {
     raster::Image sign_image = solidImage("focal_sign", 512, 256, {30, 34, 48, 255});
     drawTextCentered(sign_image, "FOCAL", 256, 60, 14, {250, 250, 240, 255});
     drawTextCentered(sign_image, "DEPTH OF FIELD", 256, 190, 5, {250, 190, 60, 255});
-    const int32_t sign_tex = addImage(scene, std::move(sign_image));
-    const int32_t sign_mat = addMaterial(scene, textured("sign", sign_tex, clamped, 0.7f));
-    raster::Primitive sign;
-    sign.material = sign_mat;
-    appendQuad(sign, {-2.0f, 1.4f, -8.0f}, {2.0f, 1.4f, -8.0f}, {2.0f, 3.4f, -8.0f},
-               {-2.0f, 3.4f, -8.0f}, {0.0f, 0.0f, 1.0f});
-    addInstance(scene, addMesh(scene, "sign", std::move(sign)));
+    addSign(scene, "sign", std::move(sign_image), clamped, 0.7f, {-2.0f, 1.4f}, {2.0f, 3.4f},
+            -8.0f);
     raster::Primitive sign_back;
     sign_back.material = stone_mat;
     appendBox(sign_back, {0.0f, 2.4f, -8.06f}, {2.05f, 1.05f, 0.05f});

@@ -34,14 +34,8 @@ raster::Scene makeGlassScene() {
     raster::Image sign_image = solidImage("glass_sign", 512, 128, {240, 236, 225, 255});
     drawTextCentered(sign_image, "ALPHA BLEND", 256, 16, 7, {25, 30, 70, 255});
     drawTextCentered(sign_image, "COLOURED GLASS AT 1.0 - 3.0 M", 256, 88, 3, {120, 30, 20, 255});
-    const int32_t sign_tex = addImage(scene, std::move(sign_image));
-    const int32_t sign_mat = addMaterial(scene, textured("sign", sign_tex, clamped, 0.8f));
-    raster::Primitive sign;
-    sign.material = sign_mat;
-    const float sz = -4.5f + 0.02f;
-    appendQuad(sign, {-1.4f, 1.75f, sz}, {1.4f, 1.75f, sz}, {1.4f, 2.45f, sz}, {-1.4f, 2.45f, sz},
-               {0.0f, 0.0f, 1.0f});
-    addInstance(scene, addMesh(scene, "sign", std::move(sign)));
+    addSign(scene, "sign", std::move(sign_image), clamped, 0.8f, {-1.4f, 1.75f}, {1.4f, 2.45f},
+            -4.5f + 0.02f);
 
     const int32_t floor_tex = addImage(
         scene, checkerImage("floor_checker", 256, 2, {190, 185, 175, 255}, {70, 70, 75, 255}));

@@ -70,14 +70,8 @@ raster::Scene makeNearFoliageScene() {
     raster::Image sign_image = solidImage("sign", 512, 128, {232, 226, 210, 255});
     drawTextCentered(sign_image, "LEAVES 0.3 - 1 M AWAY", 256, 30, 4, {30, 60, 30, 255});
     drawTextCentered(sign_image, "SHARP SIGN AT 3 M", 256, 80, 3, {140, 30, 25, 255});
-    const int32_t sign_tex = addImage(scene, std::move(sign_image));
-    const int32_t sign_mat = addMaterial(scene, textured("sign", sign_tex, clamped, 0.8f));
-    raster::Primitive sign;
-    sign.material = sign_mat;
-    const float sign_z = wall_z + 0.02f;
-    appendQuad(sign, {-0.8f, 1.35f, sign_z}, {0.8f, 1.35f, sign_z}, {0.8f, 1.75f, sign_z},
-               {-0.8f, 1.75f, sign_z}, {0.0f, 0.0f, 1.0f});
-    addInstance(scene, addMesh(scene, "sign", std::move(sign)));
+    addSign(scene, "sign", std::move(sign_image), clamped, 0.8f, {-0.8f, 1.35f}, {0.8f, 1.75f},
+            wall_z + 0.02f);
 
     const int32_t ball_tex = addImage(
         scene, checkerImage("ball_checker", 128, 8, {210, 200, 180, 255}, {90, 70, 60, 255}));

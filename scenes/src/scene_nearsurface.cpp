@@ -39,14 +39,8 @@ raster::Scene makeNearSurfaceScene() {
     drawTextCentered(sign_image, "NEAR PART", 256, 40, 8, {30, 40, 90, 255});
     drawTextCentered(sign_image, "BLURRED 40 PX IN FRONT", 256, 130, 3, {150, 30, 25, 255});
     drawTextCentered(sign_image, "OF A SHARP WALL", 256, 170, 3, {150, 30, 25, 255});
-    const int32_t sign_tex = addImage(scene, std::move(sign_image));
-    const int32_t sign_mat = addMaterial(scene, textured("sign", sign_tex, clamped, 0.8f));
-    raster::Primitive sign;
-    sign.material = sign_mat;
-    const float sign_z = wall_z + 0.01f;
-    appendQuad(sign, {-0.1f, -0.05f, sign_z}, {0.4f, -0.05f, sign_z}, {0.4f, 0.2f, sign_z},
-               {-0.1f, 0.2f, sign_z}, {0.0f, 0.0f, 1.0f});
-    addInstance(scene, addMesh(scene, "sign", std::move(sign)));
+    addSign(scene, "sign", std::move(sign_image), clamped, 0.8f, {-0.1f, -0.05f}, {0.4f, 0.2f},
+            wall_z + 0.01f);
 
     // The near part, smoothly shaded light grey: a shaft of radius 3 cm running from beyond the
     // lower-left corner of the frame (0.34 m away) towards the centre (0.17 m), a flange disc on

@@ -41,13 +41,8 @@ raster::Scene makeRailingScene() {
     drawTextCentered(sign_image, "SHARP TEXT SEEN THROUGH A BLURRED RAILING", 512, 150, 4,
                      {150, 30, 25, 255});
     drawTextCentered(sign_image, "SELGRAD ET AL. 2015 - FIG. 1", 512, 200, 3, {40, 40, 40, 255});
-    const int32_t sign_tex = addImage(scene, std::move(sign_image));
-    const int32_t sign_mat = addMaterial(scene, textured("sign", sign_tex, clamped, 0.9f));
-    raster::Primitive sign;
-    sign.material = sign_mat;
-    appendQuad(sign, {-1.5f, 0.85f, sign_z}, {1.5f, 0.85f, sign_z}, {1.5f, 1.6f, sign_z},
-               {-1.5f, 1.6f, sign_z}, {0.0f, 0.0f, 1.0f});
-    addInstance(scene, addMesh(scene, "text", std::move(sign)));
+    addSign(scene, "text", std::move(sign_image), clamped, 0.9f, {-1.5f, 0.85f}, {1.5f, 1.6f},
+            sign_z);
 
     // Floor: a checker with 50 cm cells between the railing and the wall.
     const int32_t floor_tex = addImage(
