@@ -420,6 +420,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                   {"nbuffer_levels", st.nbuffer_levels},
                   {"mip_levels", st.mip_levels},
                   {"rays", st.rays},
+                  {"pixels_in_focus", st.pixels_in_focus},
                   {"rays_discarded", st.rays_discarded},
                   {"rays_background", st.rays_background},
                   {"layer_steps", st.layer_steps},

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -64,6 +65,14 @@ struct LayerSeg {
     MipLevel cone_level; // the levels of that first lookup (its diameter is lambda |C(t_cone)|)
     bool empty = true;
     bool transparent = false; // the transparent plane has content
+    // With paths walked in advance, where a pixel's surface is seen by all its rays in its own
+    // texel (inFocusPixel): every ray's path crosses the pixel's own texel column over at least
+    // [focus_t0, focus_t1] (focus_t0 > focus_t1: some ray misses it), and the cells it crosses
+    // before lie in the offset box focus_box (empty when x0 > x1).
+    float focus_t0 = 1.0f, focus_t1 = -1.0f;
+    struct {
+        int32_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+    } focus_box;
 };
 
 // One traced ray's result inside a layer.
@@ -98,7 +107,7 @@ struct RayPath {
 struct TileCounters {
     uint64_t rays = 0, discarded = 0, background = 0, layer_tests = 0, culled_pixel = 0,
              culled_tile = 0, culled_ray = 0, cone_partial = 0, cone_missed = 0, fetches = 0,
-             transparent_hits = 0, layer_steps = 0;
+             transparent_hits = 0, layer_steps = 0, pixels_in_focus = 0;
 };
 
 // Everything the per-pixel loop reads; built once per frame.
@@ -125,6 +134,7 @@ struct Tracer {
     // ray's (the cell offset with x negated, as lensRayImageOffset); empty: cones on the rays.
     std::vector<glm::vec2> cone_offsets;
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
+    bool in_focus = false;        // pixels in focus are resolved without tracing (inFocusPixel)
     glm::vec3 background{0.0f};
 
     float cocOf(float t) const { return coc_a + coc_b * t; }
@@ -665,10 +675,11 @@ struct RayState {
 struct PixelLayers {
     uint64_t active = 0;   // not culled for the pixel (§4.3): its rays or missed cones may meet it
     uint64_t hittable = 0; // its rays can hit it at all (else only the cones see it)
+    bool resolved = false; // in focus, written without tracing (inFocusPixel)
 };
 
 // The records of pixel (x, y)'s rays in sample order when it is the debug pixel, else null.
-// beginPixel sizes them (`size` rays) before anything is recorded; the others pass 0.
+// beginRays sizes them (`size` rays) before anything is recorded; the others pass 0.
 MultiviewRayRecord* debugRecords(const Tracer& tr, uint32_t x, uint32_t y, uint32_t size = 0) {
     const MultiviewSettings& s = *tr.settings;
     if (!s.debug_rays || x != s.debug_x || y != s.debug_y)
@@ -685,9 +696,9 @@ bool rayInside(const Tracer& tr, uint32_t x, uint32_t y, glm::vec2 w, float t) {
            o.y < float(tr.height - y);
 }
 
-// Early culling per pixel (§4.3) and the start of each of its rays.
-PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_layers,
-                       uint32_t tile_layer_count, RayState* rays, TileCounters& cnt) {
+// Early culling per pixel (§4.3).
+PixelLayers pixelLayers(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_layers,
+                        uint32_t tile_layer_count, TileCounters& cnt) {
     const MultiviewSettings& s = *tr.settings;
     PixelLayers pl;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
@@ -701,6 +712,65 @@ PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t*
             pl.hittable |= uint64_t(1) << l;
         pl.active |= uint64_t(1) << l;
     }
+    return pl;
+}
+
+// A pixel in focus, resolved without tracing. Let l be its nearest active layer (nothing nearer
+// can be hit or seen by a cone: per-pixel culling with the cone margin) and h the depth of its
+// own texel there. When h lies where every ray crosses the own texel's column (LayerSeg::
+// focus_t0/t1), and no texel the rays cross before it can stop them (each such cell is left
+// at D <= focus_t0, so a texel deeper than focus_t0, or nearer than the segment, is no hit for
+// cellHit), the scan (scanPath) hits the own texel at h with every ray. There is no cone (lambda
+// |C(h)| <= 1), so each ray's colour is the texel's, and the mean is summed as endPixel sums
+// it: the same bits as tracing the rays. Writes the pixel and returns true, or returns false
+// when the rays have to be traced.
+bool inFocusPixel(const Tracer& tr, uint32_t x, uint32_t y, const PixelLayers& pl, float* out,
+                  TileCounters& cnt) {
+    if (pl.active == 0)
+        return false;
+    const uint32_t l = uint32_t(std::countr_zero(pl.active));
+    const LayerSeg& seg = tr.segs[l];
+    const float* depth = tr.scratch->depth[l].data();
+    const uint32_t texel = y * tr.width + x;
+    const float h = depth[texel];
+    if (!((pl.hittable >> l) & 1) || seg.transparent ||
+        !(h >= seg.t0 && h >= seg.focus_t0 && h <= seg.focus_t1) ||
+        (tr.settings->cone && tr.lambda * std::fabs(tr.cocOf(h)) > 1.0f))
+        return false;
+    const auto& box = seg.focus_box;
+    if (box.x0 <= box.x1) {
+        if (int64_t(x) + box.x0 < 0 || int64_t(y) + box.y0 < 0 ||
+            int64_t(x) + box.x1 >= int64_t(tr.width) || int64_t(y) + box.y1 >= int64_t(tr.height))
+            return false; // clamped reads near the border: traced
+        for (int32_t dy = box.y0; dy <= box.y1; ++dy)
+            for (int32_t dx = box.x0; dx <= box.x1; ++dx) {
+                const float hb = depth[int64_t(texel) + int64_t(dy) * tr.width + dx];
+                if ((dx != 0 || dy != 0) && hb >= seg.t0 && hb <= seg.focus_t0)
+                    return false;
+            }
+    }
+    const raster::LayeredTarget& lt = *tr.layers;
+    const glm::vec3 c(lt.color.load(lt.index(l, texel)));
+    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
+    for (uint32_t k = 0; k < tr.samples->size(); ++k) {
+        const double wt = double(tr.samples->sample(k).weight);
+        sum_r += wt * double(c.r);
+        sum_g += wt * double(c.g);
+        sum_b += wt * double(c.b);
+        sum_w += wt;
+    }
+    out[0] = float(sum_r / sum_w);
+    out[1] = float(sum_g / sum_w);
+    out[2] = float(sum_b / sum_w);
+    out[3] = 1.0f;
+    cnt.rays += tr.samples->size();
+    ++cnt.pixels_in_focus;
+    return true;
+}
+
+// The start of each of pixel (x, y)'s rays.
+void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
     // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
     std::array<float, 4> noise{};
     uint32_t halton_offset = 0;
@@ -736,7 +806,6 @@ PixelLayers beginPixel(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t*
                 rec->discarded = true, rec->t_end = t_first, rec->end_px = rec->start_px;
         }
     }
-    return pl;
 }
 
 // Ray k of pixel (x, y) through layer l (§4.3-§4.4): its opaque hit or miss, the layer's
@@ -953,8 +1022,15 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
     for (uint32_t y = y0; y < y1; ++y)
         for (uint32_t x = x0; x < x1; ++x) {
             const size_t p = size_t(y - y0) * tw + (x - x0);
-            pixel_layers[p] =
-                beginPixel(tr, x, y, tile_layers, tile_layer_count, rays + p * n, cnt);
+            PixelLayers& pl = pixel_layers[p];
+            pl = pixelLayers(tr, x, y, tile_layers, tile_layer_count, cnt);
+            if (tr.in_focus && !debugRecords(tr, x, y) &&
+                inFocusPixel(tr, x, y, pl, rgba + (size_t(y) * tr.width + x) * 4, cnt)) {
+                pl.active = 0;
+                pl.resolved = true;
+                continue;
+            }
+            beginRays(tr, x, y, rays + p * n, cnt);
         }
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
         const uint32_t l = tile_layers[i];
@@ -979,7 +1055,8 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
     for (uint32_t y = y0; y < y1; ++y)
         for (uint32_t x = x0; x < x1; ++x) {
             const size_t p = size_t(y - y0) * tw + (x - x0);
-            endPixel(tr, x, y, rays + p * n, rgba + (size_t(y) * tr.width + x) * 4, cnt);
+            if (!pixel_layers[p].resolved)
+                endPixel(tr, x, y, rays + p * n, rgba + (size_t(y) * tr.width + x) * 4, cnt);
         }
 }
 
@@ -1475,6 +1552,35 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                                                       tr.segs[l].t1, tr.cells));
             }
             stats.path_cells = tr.cells.size();
+            for (uint32_t l = 0; l < m; ++l) {
+                LayerSeg& seg = tr.segs[l];
+                if (seg.empty)
+                    continue;
+                seg.focus_t1 = seg.t1;
+                for (uint32_t k = 0; k < samples.size(); ++k) {
+                    const RayPath& path = tr.paths[size_t(k) * m + l];
+                    const PathCell* cells = tr.cells.data() + path.first;
+                    uint32_t i = 0;
+                    while (i < path.count && (cells[i].dx != 0 || cells[i].dy != 0)) {
+                        auto& box = seg.focus_box;
+                        const bool first = box.x0 > box.x1;
+                        box.x0 = first ? cells[i].dx : std::min(box.x0, cells[i].dx);
+                        box.x1 = first ? cells[i].dx : std::max(box.x1, cells[i].dx);
+                        box.y0 = first ? cells[i].dy : std::min(box.y0, cells[i].dy);
+                        box.y1 = first ? cells[i].dy : std::max(box.y1, cells[i].dy);
+                        ++i;
+                    }
+                    if (i == path.count) { // this ray never crosses its own texel here
+                        seg.focus_t0 = 1.0f, seg.focus_t1 = -1.0f;
+                        break;
+                    }
+                    seg.focus_t0 = k == 0 ? cells[i].t_in : std::max(seg.focus_t0, cells[i].t_in);
+                    seg.focus_t1 = std::min(seg.focus_t1, cells[i].t_out);
+                }
+            }
+            // inFocusPixel repeats what traceLayer and endPixel do for a ray that hits its own
+            // texel: lens-centre shading and no ray dropped at the image border.
+            tr.in_focus = !shade && settings.offscreen == OffscreenPolicy::Clamp;
         }
     }
     rgba.assign(pixels * 4, 0.0f);
@@ -1520,6 +1626,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         stats.texel_fetches += c.fetches;
         stats.layer_steps += c.layer_steps;
         stats.transparent_hits += c.transparent_hits;
+        stats.pixels_in_focus += c.pixels_in_focus;
     }
     stats.ms_tracing = msSince(t0);
     return stats;

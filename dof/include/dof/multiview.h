@@ -173,7 +173,8 @@ struct MultiviewStats {
     bool cones_on_cells = false; // the cones were centred on their samples' cells (ConeCentre)
     uint32_t nbuffer_levels = 0; // most levels any layer needed
     uint32_t mip_levels = 0;
-    uint64_t rays = 0;               // lens rays traced (pixels x N)
+    uint64_t rays = 0;               // lens rays (pixels x N), traced or in focus
+    uint64_t pixels_in_focus = 0;    // pixels whose rays all see their own texel, not traced
     uint64_t rays_discarded = 0;     // left the image (OffscreenPolicy::Discard)
     uint64_t rays_background = 0;    // passed every layer without a hit
     uint64_t layer_steps = 0;        // (ray, layer) pairs visited

@@ -4,6 +4,7 @@
 
 #include <dof/metrics.h>
 #include <dof/multiview.h>
+#include <scenes/builtin.h>
 
 #include <gtest/gtest.h>
 
@@ -378,6 +379,39 @@ TEST(Multiview, PrecomputedPathsGiveTheSameBytes) {
     dof::MultiviewSettings noise;
     noise.jitter = dof::JitterMode::Noise; // per-pixel samples: nothing to share
     EXPECT_EQ(runMultiview(c.scene, c.view, c.lens, samples, noise).stats.path_cells, 0u);
+}
+
+TEST(Multiview, InFocusPixelsGiveTheTracedBytes) {
+    // Pixels whose rays all hit their own texel are resolved without tracing (inFocusPixel);
+    // without precomputed paths every pixel is traced. nearsurface: a sharp background seen
+    // beside and through a blurred near surface; reflective: sharp objects on a floor, whose
+    // silhouettes over the floor in the same layer stop some rays before their own texel.
+    // Cones on and off, thin and solid texels, wide and narrow layers.
+    for (const char* name : {"nearsurface", "reflective"}) {
+        raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(name);
+        ASSERT_TRUE(scene.ok());
+        const raster::View view = raster::viewFromCamera(scene->cameras[0], 160, 120);
+        const dof::ThinLens lens =
+            dof::makeThinLens(view, scene->lens->aperture_radius, scene->lens->focus_distance);
+        const dof::LensSampleSet samples = makeSamples(24);
+        for (const char* config : {"default", "cone off", "thickness inf", "spacing 1"}) {
+            dof::MultiviewSettings on;
+            on.cone = std::strcmp(config, "cone off") != 0;
+            if (std::strcmp(config, "thickness inf") == 0)
+                on.thickness_px = INFINITY;
+            if (std::strcmp(config, "spacing 1") == 0)
+                on.layer_spacing_px = 1.0f;
+            dof::MultiviewSettings off = on;
+            off.precompute_paths = false;
+            const MvRun a = runMultiview(*scene, view, lens, samples, on, 2);
+            const MvRun b = runMultiview(*scene, view, lens, samples, off, 2);
+            EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color)) << name << config;
+            EXPECT_GT(a.stats.pixels_in_focus, 160u * 120u / 20) << name << config;
+            EXPECT_LT(a.stats.pixels_in_focus, 160u * 120u) << name << config;
+            EXPECT_EQ(b.stats.pixels_in_focus, 0u) << name << config;
+            EXPECT_EQ(a.stats.rays, b.stats.rays) << name << config;
+        }
+    }
 }
 
 // Mean absolute error over a pixel box against a reference.
