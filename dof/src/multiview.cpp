@@ -52,6 +52,14 @@ struct MipLevel {
     float f = 0.0f;
 };
 
+// One level of a layer mipmap (MultiviewScratch) as the lookups read it, flattened per frame.
+struct MipView {
+    const float* data = nullptr;
+    int64_t width = 0, height = 0;
+    float last_u = 0.0f, last_v = 0.0f; // width - 1, height - 1: the last interior taps
+};
+using MipChain = std::array<MipView, kMaxMipLevels>;
+
 // Per-layer constants of the traversal, in stored depth D (the ray is a straight line in
 // (x, y, D) because both the image offset C and D are affine in 1/d: Eq. 3 and camera.h).
 struct LayerSeg {
@@ -133,6 +141,8 @@ struct Tracer {
     // ConeCentre::Cell: per sample, its cone centre's image offset per unit C relative to the
     // ray's (the cell offset with x negated, as lensRayImageOffset); empty: cones on the rays.
     std::vector<glm::vec2> cone_offsets;
+    // Per layer: its colour, owned and transparent mipmaps (MultiviewScratch), where built.
+    std::vector<MipChain> mips, owned_mips, transparent_mips;
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     bool in_focus = false;        // pixels in focus are resolved without tracing (inFocusPixel)
     glm::vec3 background{0.0f};
@@ -376,12 +386,10 @@ MipLevel mipLevelFor(const Tracer& tr, float diameter) {
 // Trilinear lookup of the first C channels of a layer mipmap `mip` with Stride channels per
 // texel (§4.4) at image position (px, py) on the levels `lv`.
 template <int C, int Stride = C>
-std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<float>>& mip,
-                               float px, float py, MipLevel lv) {
-    const MultiviewScratch& sc = *tr.scratch;
+std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel lv) {
     auto bilinear = [&](uint32_t level) {
-        const float* img = mip[level].data();
-        const int64_t w = sc.mip_width[level], h = sc.mip_height[level];
+        const MipView& m = mip[level];
+        const int64_t w = m.width, h = m.height;
         const float scale = kMipScale[level];
         const float u = px * scale - 0.5f, v = py * scale - 0.5f;
         const float fu = std::floor(u), fv = std::floor(v);
@@ -389,11 +397,11 @@ std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<f
         const float* r0;
         const float* r1;
         int64_t x0, x1;
-        if (fu >= 0.0f && fv >= 0.0f && fu < float(w - 1) && fv < float(h - 1)) {
+        if (fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v) {
             // Inside the level: the four texels need no clamping (the usual case).
             x0 = int64_t(fu) * Stride;
             x1 = x0 + Stride;
-            r0 = img + size_t(int64_t(fv) * w) * Stride;
+            r0 = m.data + size_t(int64_t(fv) * w) * Stride;
             r1 = r0 + size_t(w) * Stride;
         } else {
             // Clamped to the level (the position may lie far outside it when a clamped ray
@@ -402,8 +410,8 @@ std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<f
             const int64_t iv = int64_t(std::clamp(fv, -1.0f, float(h)));
             x0 = std::clamp<int64_t>(iu, 0, w - 1) * Stride;
             x1 = std::clamp<int64_t>(iu + 1, 0, w - 1) * Stride;
-            r0 = img + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * Stride;
-            r1 = img + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * Stride;
+            r0 = m.data + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * Stride;
+            r1 = m.data + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * Stride;
         }
         std::array<float, C> out;
         for (int c = 0; c < C; ++c) {
@@ -422,16 +430,39 @@ std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<f
     return c0;
 }
 
+// Whether sampleMip on `mip` (Stride channels per texel, a non-negative coverage in channel
+// `channel`) at (px, py) on the levels lv returns exactly 0 in that channel because every
+// texel it reads is empty there: when both levels' taps lie inside their levels, the taps of
+// the finer level l0 lie in the 2x2 blocks the coarser level's four taps average (u0 = 2 u1 +
+// 1/2), so four zero coverages at the last level read decide it. False when unsure.
+template <int Stride>
+bool mipEmptyAt(const MipChain& mip, int channel, float px, float py, MipLevel lv) {
+    const float* taps = nullptr;
+    int64_t row = 0;
+    for (const uint32_t level : {lv.l0, lv.l1}) {
+        const MipView& m = mip[level];
+        const float scale = kMipScale[level];
+        const float fu = std::floor(px * scale - 0.5f), fv = std::floor(py * scale - 0.5f);
+        if (!(fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v))
+            return false;
+        row = m.width * Stride;
+        taps = m.data + (int64_t(fv) * m.width + int64_t(fu)) * Stride + channel;
+        if (lv.l1 == lv.l0 || lv.f == 0.0f)
+            break; // sampleMip reads l0 only
+    }
+    return taps[0] == 0.0f && taps[Stride] == 0.0f && taps[row] == 0.0f &&
+           taps[row + Stride] == 0.0f;
+}
+
 // The same for a window of `diameter` pixels.
 template <int C, int Stride = C>
-std::array<float, C> sampleMip(const Tracer& tr, const std::vector<std::vector<float>>& mip,
-                               float px, float py, float diameter) {
-    return sampleMip<C, Stride>(tr, mip, px, py, mipLevelFor(tr, diameter));
+std::array<float, C> sampleMip(const Tracer& tr, const MipChain& mip, float px, float py,
+                               float diameter) {
+    return sampleMip<C, Stride>(mip, px, py, mipLevelFor(tr, diameter));
 }
 
 // A layer's premultiplied coverage mipmap (RGBA, alpha = coverage) at a cone (§4.4).
-glm::vec4 sampleCone(const Tracer& tr, const std::vector<std::vector<float>>& mip, float px,
-                     float py, float diameter) {
+glm::vec4 sampleCone(const Tracer& tr, const MipChain& mip, float px, float py, float diameter) {
     const std::array<float, 4> m = sampleMip<4>(tr, mip, px, py, diameter);
     return {m[0], m[1], m[2], m[3]};
 }
@@ -611,8 +642,11 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
     float px = 0.0f, py = 0.0f;
     if (!at(seg.t_cone, px, py))
         return std::nullopt;
-    const std::vector<std::vector<float>>& owned = tr.scratch->owned_mips[l];
-    const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(tr, owned, px, py, seg.cone_level);
+    const MipChain& owned = tr.owned_mips[l];
+    // Most rays pass where the layer owns nothing near them: no coverage, no lookup.
+    if (mipEmptyAt<kOwnedChannels>(owned, 1, px, py, seg.cone_level))
+        return std::nullopt;
+    const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(owned, px, py, seg.cone_level);
     if (!(d[1] > 0.0f))
         return std::nullopt;
     MissCone cone;
@@ -896,11 +930,10 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
         if (ht.hit && ray.transmit > 0.0f) {
             ++cnt.transparent_hits;
             const float ct = tr.cocOf(ht.t);
-            const glm::vec4 m =
-                s.cone && tr.lambda * std::fabs(ct) > 1.0f
-                    ? sampleCone(tr, tr.scratch->transparent_mips[l], cx + ct * wc.x,
-                                 cy + ct * wc.y, tr.lambda * std::fabs(ct))
-                    : lt.transparent_color.load(lt.index(l, ht.texel));
+            const glm::vec4 m = s.cone && tr.lambda * std::fabs(ct) > 1.0f
+                                    ? sampleCone(tr, tr.transparent_mips[l], cx + ct * wc.x,
+                                                 cy + ct * wc.y, tr.lambda * std::fabs(ct))
+                                    : lt.transparent_color.load(lt.index(l, ht.texel));
             glm::vec3 rgb(m);
             const size_t ti = lt.index(l, ht.texel);
             if (shade && lt.transparent_top_alpha[ti] > 0.0f) {
@@ -934,8 +967,8 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
     if (cone_hit) {
         // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha is its
         // coverage v1, the mipmapped RGB / v1 its mean colour c1.
-        const glm::vec4 m = sampleCone(tr, tr.scratch->mips[l], cx + c_hit * wc.x,
-                                       cy + c_hit * wc.y, tr.lambda * std::fabs(c_hit));
+        const glm::vec4 m = sampleCone(tr, tr.mips[l], cx + c_hit * wc.x, cy + c_hit * wc.y,
+                                       tr.lambda * std::fabs(c_hit));
         v1 = std::clamp(m.a, 0.0f, 1.0f);
         c1 = v1 > 0.0f ? glm::vec3(m) / m.a : glm::vec3(0.0f);
     } else {
@@ -1509,6 +1542,18 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                 });
         });
     }
+    auto views = [&](const std::vector<std::vector<std::vector<float>>>& layer_mips) {
+        std::vector<MipChain> chains(layer_mips.size());
+        for (size_t l = 0; l < layer_mips.size(); ++l)
+            for (size_t lv = 0; lv < layer_mips[l].size(); ++lv) {
+                const int64_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
+                chains[l][lv] = {layer_mips[l][lv].data(), w, h, float(w - 1), float(h - 1)};
+            }
+        return chains;
+    };
+    tr.mips = views(scratch.mips);
+    tr.owned_mips = views(scratch.owned_mips);
+    tr.transparent_mips = views(scratch.transparent_mips);
     for (LayerSeg& seg : tr.segs)
         if (seg.cone_px > 0.0f)
             seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
