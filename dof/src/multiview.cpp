@@ -71,6 +71,10 @@ struct LayerSeg {
     // position there (0: misses are not coned).
     float t_cone = 0.0f, cone_px = 0.0f;
     MipLevel cone_level; // the levels of that first lookup (its diameter is lambda |C(t_cone)|)
+    // Every ray's first lookup reads texels within first_cone_px of its pixel's centre: the ray
+    // is within r_max |C(t_cone)| of it at t_cone, and a bilinear tap of level L within 1.5 2^L
+    // of the ray (+1 for rounding).
+    float first_cone_px = 0.0f;
     bool empty = true;
     bool transparent = false; // the transparent plane has content
     // With paths walked in advance, where a pixel's surface is seen by all its rays in its own
@@ -584,12 +588,14 @@ LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
 // Whether layer l has no texel within its segment in the texel box [x0, x1] x [y0, y1]
 // (clamped to the image, as OffscreenPolicy::Clamp reads it): one N-buffer query, §4.3 early
 // culling (the minimum depth in the window is beyond the layer's far bound).
-bool boxCulled(const Tracer& tr, uint32_t l, int64_t x0, int64_t x1, int64_t y0, int64_t y1) {
+// `beyond`: the depth past which texels do not count (the segment's far bound by default).
+bool boxCulled(const Tracer& tr, uint32_t l, int64_t x0, int64_t x1, int64_t y0, int64_t y1,
+               std::optional<float> beyond = std::nullopt) {
     const int64_t w_max = int64_t(tr.width) - 1, h_max = int64_t(tr.height) - 1;
     x0 = std::clamp<int64_t>(x0, 0, w_max), x1 = std::clamp<int64_t>(x1, 0, w_max);
     y0 = std::clamp<int64_t>(y0, 0, h_max), y1 = std::clamp<int64_t>(y1, 0, h_max);
     const int64_t size = std::max(x1 - x0, y1 - y0) + 1;
-    return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > tr.segs[l].t1;
+    return nBufferMin(tr.scratch->nbuffers[l], x0, y0, size) > beyond.value_or(tr.segs[l].t1);
 }
 
 // Whether layer l has no texel within `margin` pixels of what the rays of the pixels
@@ -742,8 +748,22 @@ PixelLayers pixelLayers(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t
             ++cnt.culled_pixel;
             continue;
         }
-        if (!s.culling || cone_px == 0.0f || !culled(tr, l, x, x, y, y, 0.0f))
-            pl.hittable |= uint64_t(1) << l;
+        const bool hittable = !s.culling || cone_px == 0.0f || !culled(tr, l, x, x, y, y, 0.0f);
+        if (!hittable) {
+            // Only the missed cones can see this layer. Their first lookup (missCone) reads
+            // within first_cone_px of the pixel centre (clamped to the image, so nearer to it)
+            // and finds coverage only where the layer owns a texel (depth <= own1): when none
+            // is there, the layer holds nothing for this pixel. (Not asked of hittable layers:
+            // the query costs more than the lookups it saves there.)
+            const float r = tr.segs[l].first_cone_px;
+            const int64_t lo = int64_t(std::floor(0.5f - r)), hi = int64_t(std::floor(0.5f + r));
+            if (boxCulled(tr, l, int64_t(x) + lo, int64_t(x) + hi, int64_t(y) + lo, int64_t(y) + hi,
+                          tr.segs[l].own1)) {
+                ++cnt.culled_pixel;
+                continue;
+            }
+        }
+        pl.hittable |= uint64_t(hittable) << l;
         pl.active |= uint64_t(1) << l;
     }
     return pl;
@@ -1555,8 +1575,11 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     tr.owned_mips = views(scratch.owned_mips);
     tr.transparent_mips = views(scratch.transparent_mips);
     for (LayerSeg& seg : tr.segs)
-        if (seg.cone_px > 0.0f)
+        if (seg.cone_px > 0.0f) {
             seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
+            seg.first_cone_px = tr.r_max * std::fabs(tr.cocOf(seg.t_cone)) +
+                                1.5f * std::ldexp(1.0f, int(seg.cone_level.l1)) + 1.0f;
+        }
     stats.ms_mipmaps = msSince(t0);
     for (uint32_t l = 0; l < m; ++l) {
         for (const std::vector<float>& lv : scratch.nbuffers[l].levels)
