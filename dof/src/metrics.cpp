@@ -15,9 +15,9 @@ namespace {
 void rgbOf(const ImageRef& img, size_t i, double out[3]) {
     const float* p = img.pixels + i * img.channels;
     if (img.channels >= 3) {
-        out[0] = p[0], out[1] = p[1], out[2] = p[2];
+        out[0] = double(p[0]), out[1] = double(p[1]), out[2] = double(p[2]);
     } else {
-        out[0] = out[1] = out[2] = p[0];
+        out[0] = out[1] = out[2] = double(p[0]);
     }
 }
 
