@@ -1,6 +1,8 @@
 #include <dof/metrics.h>
+#include <raster/check.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -163,6 +165,23 @@ raster::Result<ErrorMetrics> compareImages(const ImageRef& a, const ImageRef& b,
     m.ssim = m.ssim_windows ? ssim_sum / double(m.ssim_windows)
                             : std::numeric_limits<double>::quiet_NaN();
     return m;
+}
+
+uint64_t countDifferingPixels(const ImageRef& a, const ImageRef& b, float tolerance) {
+    FOCAL_CHECK(a.width == b.width && a.height == b.height);
+    const uint32_t channels = std::min(a.channels, b.channels);
+    const size_t n = size_t(a.width) * a.height;
+    uint64_t differing = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const float* pa = a.pixels + i * a.channels;
+        const float* pb = b.pixels + i * b.channels;
+        bool differs = false;
+        for (uint32_t c = 0; c < channels && !differs; ++c)
+            differs = std::bit_cast<uint32_t>(pa[c]) != std::bit_cast<uint32_t>(pb[c]) &&
+                      !(std::fabs(pa[c] - pb[c]) <= tolerance);
+        differing += differs;
+    }
+    return differing;
 }
 
 std::vector<uint8_t> discontinuityBand(const ImageRef& depth, float relative_jump,
