@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,13 +39,23 @@ protected:
         args.insert(args.begin(), FOCAL_BINARY);
         return runProcess(args);
     }
-    // A 48x36 render of builtin:demo with `method`.
-    std::string render(const std::string& name, const std::string& method) {
+    // star.pgm written as a PNG with `edit` applied to its 8-bit grey samples: the same pixels
+    // in another file format, or a few changed. No render: every process costs a start-up.
+    std::string star(const std::string& name,
+                     const std::function<void(std::vector<unsigned char>&)>& edit = {}) {
+        auto in = OIIO::ImageInput::open(kStar);
+        EXPECT_TRUE(in);
+        if (!in)
+            return {};
+        const OIIO::ImageSpec spec = in->spec();
+        std::vector<unsigned char> pixels(size_t(spec.width) * spec.height * spec.nchannels);
+        EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data()));
+        if (edit)
+            edit(pixels);
         const std::string out = path(name);
-        const ProcessResult r =
-            focal({"render", "builtin:demo", "-o", out, "--width", "48", "--height", "36",
-                   "--threads", "2", "--method", method, "--samples", "4", "--no-progress"});
-        EXPECT_EQ(r.exit_code, 0) << r.err;
+        auto writer = OIIO::ImageOutput::create(out);
+        EXPECT_TRUE(writer && writer->open(out, spec) &&
+                    writer->write_image(OIIO::TypeDesc::UINT8, pixels.data()) && writer->close());
         return out;
     }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
@@ -59,29 +70,14 @@ TEST_F(GateCli, HashFollowsTheDocumentedDefinition) {
 
 TEST_F(GateCli, HashCoversPixelsNotFileBytes) {
     // The same 8-bit pixels as PGM and as PNG: different files, one hash.
-    auto in = OIIO::ImageInput::open(kStar);
-    ASSERT_TRUE(in);
-    OIIO::ImageSpec spec = in->spec();
-    std::vector<unsigned char> pixels(size_t(spec.width) * spec.height * spec.nchannels);
-    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data()));
-    const std::string png = path("star.png");
-    auto out = OIIO::ImageOutput::create(png);
-    ASSERT_TRUE(out && out->open(png, spec));
-    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-    ASSERT_TRUE(out->close());
+    const std::string png = star("star.png");
     const ProcessResult r = focal({"hash", png, kStar});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::vector<std::string> lines = splitLines(r.out);
     ASSERT_EQ(lines.size(), 2u) << r.out;
     EXPECT_EQ(lines[0], std::string(kStarHash) + "  " + png);
-
     // A one-sample change changes it.
-    pixels[0] ^= 1;
-    const std::string changed = path("changed.png");
-    out = OIIO::ImageOutput::create(changed);
-    ASSERT_TRUE(out && out->open(changed, spec));
-    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
-    ASSERT_TRUE(out->close());
+    const std::string changed = star("changed.png", [](auto& p) { p[0] ^= 1; });
     EXPECT_EQ(focal({"hash", changed, "--expect", kStarHash}).exit_code, 1);
 }
 
@@ -103,26 +99,36 @@ TEST_F(GateCli, HashExpectAndErrors) {
     EXPECT_EQ(focal({"hash"}).exit_code, 2);
 }
 
+// star.pgm with four pixels of the star's tips darkened from 255 to 128: every metric sees it.
+std::function<void(std::vector<unsigned char>&)> dentTheStar() {
+    return [](std::vector<unsigned char>& p) {
+        int dented = 0;
+        for (size_t i = 0; i < p.size() && dented < 4; ++i)
+            if (p[i] == 255)
+                p[i] = 128, ++dented;
+    };
+}
+
 TEST_F(GateCli, CompareGatePassesWithinAndFailsOutsideEachThreshold) {
-    const std::string accum = render("accum.exr", "accum");
-    const std::string gather = render("gather.exr", "gather");
+    const std::string a = star("a.png");
+    const std::string b = star("b.png", dentTheStar());
     const std::string diff = path("diff.png");
     // Identical images pass every threshold, and a gate that passes writes no diff.
-    ProcessResult r = focal({"compare", accum, accum, "--max-abs", "0", "--min-psnr", "inf",
+    ProcessResult r = focal({"compare", a, kStar, "--max-abs", "0", "--min-psnr", "inf",
                              "--min-ssim", "1", "--max-differing", "0", "--diff", diff});
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
     EXPECT_FALSE(fs::exists(diff));
 
-    // Each threshold alone fails on two different methods and names its metric.
+    // Each threshold alone fails and names its metric, and the failing gate writes the diff.
     const std::vector<std::pair<std::vector<std::string>, std::string>> failing = {
-        {{"--max-abs", "0.0001"}, "max_abs_error"},
-        {{"--min-psnr", "90"}, "psnr_linear_db"},
-        {{"--min-ssim", "0.99999"}, "ssim"},
-        {{"--max-differing", "0"}, "differing_pixels"},
+        {{"--max-abs", "0.1"}, "max_abs_error"},
+        {{"--min-psnr", "40"}, "psnr_linear_db"},
+        {{"--min-ssim", "0.9999"}, "ssim"},
+        {{"--max-differing", "3"}, "differing_pixels"},
     };
     for (const auto& [option, metric] : failing) {
-        std::vector<std::string> args = {"compare", accum, gather, "--diff", diff};
+        std::vector<std::string> args = {"compare", a, b, "--diff", diff};
         args.insert(args.end(), option.begin(), option.end());
         r = focal(args);
         EXPECT_EQ(r.exit_code, 1) << option[0];
@@ -132,23 +138,24 @@ TEST_F(GateCli, CompareGatePassesWithinAndFailsOutsideEachThreshold) {
         EXPECT_TRUE(fs::exists(diff)) << option[0];
         fs::remove(diff);
     }
-    // Loose thresholds pass; a tolerance above every difference makes no pixel differ.
-    r = focal({"compare", accum, gather, "--max-abs", "1000", "--min-psnr", "1", "--min-ssim", "0",
-               "--max-differing", "0", "--tolerance", "1000"});
+    // Thresholds the dent stays within pass; a tolerance above it makes no pixel differ.
+    r = focal({"compare", a, b, "--max-abs", "1", "--min-psnr", "10", "--min-ssim", "0.5",
+               "--max-differing", "4"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    r = focal({"compare", a, b, "--max-differing", "0", "--tolerance", "1"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
 TEST_F(GateCli, CompareJsonCarriesTheGate) {
-    const std::string accum = render("accum.exr", "accum");
-    const std::string gather = render("gather.exr", "gather");
-    const ProcessResult r = focal({"compare", accum, gather, "--json", "--min-psnr", "1",
+    const std::string b = star("b.png", dentTheStar());
+    const ProcessResult r = focal({"compare", kStar, b, "--json", "--min-psnr", "1",
                                    "--max-differing", "3", "--tolerance", "0.01"});
     EXPECT_EQ(r.exit_code, 1) << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["schema"], "focal.compare");
     EXPECT_EQ(j["schema_version"], 1);
     EXPECT_EQ(j["tolerance"].get<double>(), double(0.01f));
-    EXPECT_GT(j["differing_pixels"].get<uint64_t>(), 3u);
+    EXPECT_EQ(j["differing_pixels"].get<uint64_t>(), 4u);
     EXPECT_FALSE(j["gate"]["passed"].get<bool>());
     ASSERT_EQ(j["gate"]["checks"].size(), 2u);
     EXPECT_EQ(j["gate"]["checks"][0]["metric"], "psnr_linear_db");
@@ -156,18 +163,18 @@ TEST_F(GateCli, CompareJsonCarriesTheGate) {
     EXPECT_EQ(j["gate"]["checks"][1]["metric"], "differing_pixels");
     EXPECT_EQ(j["gate"]["checks"][1]["option"], "--max-differing");
     EXPECT_EQ(j["gate"]["checks"][1]["limit"], 3.0);
+    EXPECT_EQ(j["gate"]["checks"][1]["value"], 4.0);
     EXPECT_FALSE(j["gate"]["checks"][1]["passed"].get<bool>());
     EXPECT_FALSE(j.contains("diff"));
 }
 
 TEST_F(GateCli, CompareUsageAndIoErrorsExitTwo) {
-    const std::string accum = render("accum.exr", "accum");
     for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
-             {"compare", accum, path("nope.exr"), "--max-abs", "1"},
-             {"compare", accum, accum, "--tolerance", "0.1"}, // needs --max-differing
-             {"compare", accum, accum, "--max-abs", "-1"},
-             {"compare", accum, accum, "--min-ssim", "2"},
-             {"compare", accum, accum, "--min-psnr", "nan"},
+             {"compare", kStar, path("nope.exr"), "--max-abs", "1"},
+             {"compare", kStar, kStar, "--tolerance", "0.1"}, // needs --max-differing
+             {"compare", kStar, kStar, "--max-abs", "-1"},
+             {"compare", kStar, kStar, "--min-ssim", "2"},
+             {"compare", kStar, kStar, "--min-psnr", "nan"},
          }) {
         const ProcessResult r = focal(args);
         EXPECT_EQ(r.exit_code, 2) << args[3] << ": " << r.err;
