@@ -359,6 +359,22 @@ std::vector<uint8_t> toSrgb8(const raster::Frame& frame) {
     return ::testing::AssertionFailure() << msg.str();
 }
 
+::testing::AssertionResult
+variantsDiffer(const GoldenStore& store,
+               std::span<const std::pair<const char*, const char*>> pairs) {
+    const std::map<std::string, uint64_t> hashes = readGoldenHashes(store.hashFile());
+    std::ostringstream msg;
+    for (const auto& [a, b] : pairs) {
+        if (!hashes.count(a) || !hashes.count(b))
+            msg << "no golden hash for " << a << " or " << b << "\n";
+        else if (hashes.at(a) == hashes.at(b))
+            msg << a << " and " << b << " render the same bits\n";
+    }
+    if (msg.str().empty())
+        return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << msg.str();
+}
+
 ::testing::AssertionResult holdsExactly(const GoldenStore& store,
                                         const std::vector<std::string>& names) {
     const std::set<std::string> known(names.begin(), names.end());

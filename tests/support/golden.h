@@ -14,7 +14,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace focal::test {
@@ -72,6 +74,12 @@ std::vector<uint8_t> toSrgb8(const raster::Frame& frame);
 // unreadable or not RGBA.
 bool readPngRgba8(const std::filesystem::path& path, uint32_t& width, uint32_t& height,
                   std::vector<uint8_t>& rgba, std::string& error);
+
+// Each pair of cases in `pairs` has different stored hashes in `store`: the option that tells a
+// variant from its base changes the pixels, so the variant pins something of its own.
+::testing::AssertionResult
+variantsDiffer(const GoldenStore& store,
+               std::span<const std::pair<const char*, const char*>> pairs);
 
 // Compares `frame`, whose hash is `hash`, with the golden called `name` in `store` (see the top
 // of this file), or updates it.
