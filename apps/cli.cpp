@@ -2,6 +2,7 @@
 
 #include "apps/bench_command.h"
 #include "apps/compare_command.h"
+#include "apps/hash_command.h"
 #include "apps/render_command.h"
 #include "apps/scene_info.h"
 #include "apps/scene_source.h"
@@ -62,6 +63,9 @@ int runCli(int argc, char** argv) {
     CompareArgs compare_args;
     CLI::App* compare = addCompareCommand(app, compare_args);
 
+    HashArgs hash_args;
+    CLI::App* hash = addHashCommand(app, hash_args);
+
     BenchArgs bench_args;
     CLI::App* bench = addBenchCommand(app, bench_args);
 
@@ -95,6 +99,8 @@ int runCli(int argc, char** argv) {
         return runRender(render_args);
     if (compare->parsed())
         return runCompare(compare_args);
+    if (hash->parsed())
+        return runHash(hash_args);
     if (bench->parsed())
         return runBench(bench_args);
     if (info->parsed())

@@ -8,12 +8,14 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <system_error>
 #include <unistd.h>
 
 namespace focal {
 
 namespace fs = std::filesystem;
+using raster::Result;
 using raster::Status;
 
 bool isLinearFormat(const std::string& path) {
@@ -96,13 +98,50 @@ Status writeImage(const std::string& path, const ImageData& image) {
     return s;
 }
 
-raster::Result<ImageData> readImage(const std::string& path) {
+namespace {
+
+// Opens `path` for reading; `config` carries reader hints (e.g. oiio:UnassociatedAlpha).
+Result<std::unique_ptr<OIIO::ImageInput>> openImage(const std::string& path,
+                                                    const OIIO::ImageSpec* config = nullptr) {
     std::error_code ec;
     if (!fs::exists(path, ec))
         return Status::error(path + ": file not found");
-    auto in = OIIO::ImageInput::open(path);
+    auto in = OIIO::ImageInput::open(path, config);
     if (!in)
         return Status::error(path + ": cannot read image (" + oneLine(OIIO::geterror()) + ")");
+    return in;
+}
+
+} // namespace
+
+Result<ImageSamples> readImageSamples(const std::string& path) {
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(path, &config);
+    if (!opened.ok())
+        return opened.status();
+    OIIO::ImageInput& in = **opened;
+    const OIIO::ImageSpec& spec = in.spec();
+    const OIIO::TypeDesc type =
+        spec.format.basetype == OIIO::TypeDesc::UINT8    ? OIIO::TypeDesc::UINT8
+        : spec.format.basetype == OIIO::TypeDesc::UINT16 ? OIIO::TypeDesc::UINT16
+                                                         : OIIO::TypeDesc::FLOAT;
+    ImageSamples img;
+    img.width = uint32_t(spec.width);
+    img.height = uint32_t(spec.height);
+    img.channels = uint32_t(spec.nchannels);
+    img.bytes_per_sample = uint32_t(type.size());
+    img.bytes.resize(size_t(img.width) * img.height * img.channels * img.bytes_per_sample);
+    if (!in.read_image(0, 0, 0, spec.nchannels, type, img.bytes.data()))
+        return Status::error(path + ": cannot decode image (" + oneLine(in.geterror()) + ")");
+    return img;
+}
+
+raster::Result<ImageData> readImage(const std::string& path) {
+    Result<std::unique_ptr<OIIO::ImageInput>> opened = openImage(path);
+    if (!opened.ok())
+        return opened.status();
+    std::unique_ptr<OIIO::ImageInput>& in = *opened;
     const OIIO::ImageSpec& spec = in->spec();
     ImageData img;
     img.width = uint32_t(spec.width);

@@ -26,6 +26,7 @@ raster::Status runGather(const GatherArgs& args, const MethodInput& in, MethodOu
     dof::GatherSettings settings = args.settings;
     settings.tile_size = in.options.tile_size;
     settings.skip_tiles = !args.no_skip;
+    settings.simd = in.options.simd;
     if (raster::Status s = dof::validate(settings); !s.ok())
         return s;
     if (raster::Status s = dof::validate(in.lens, in.view); !s.ok())
@@ -71,6 +72,7 @@ raster::Status runGather(const GatherArgs& args, const MethodInput& in, MethodOu
                   {"min_radius_px", settings.min_radius_px},
                   {"tile_size", settings.tile_size},
                   {"skip_tiles", settings.skip_tiles},
+                  {"simd", settings.simd},
                   {"depth_format",
                    frame.depth.format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"},
                   {"coc_a_px", st.coc.a},

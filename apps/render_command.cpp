@@ -35,6 +35,10 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
+// The version of the --stats layout (docs/stats-schema.md): bumped on any change that could break
+// a reader (a removed or renamed field, a changed meaning or unit), not for new fields.
+constexpr int kStatsSchemaVersion = 1;
+
 Result<glm::vec3> parseVec3(const std::string& option, const std::string& text) {
     glm::vec3 v(0.0f);
     std::istringstream in(text);
@@ -680,6 +684,8 @@ int runRender(const RenderArgs& args) {
     if (!args.stats_path.empty()) {
         const raster::View& v = *view;
         nlohmann::json j;
+        j["schema"] = "focal.render-stats";
+        j["schema_version"] = kStatsSchemaVersion;
         j["scene"] = args.scene;
         j["output"] = args.outputs.front();
         j["outputs"] = args.outputs;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README command (b): install what is missing, build, and run the whole test suite:
-# the Release build (every test, warnings as errors) and the ASan+UBSan build (quick tier).
+# the Release build (every test, warnings as errors), the ASan+UBSan build (quick tier) and a
+# clang++ Release build of focal and the golden tests, which must match the same goldens as g++.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install-deps.sh
@@ -11,4 +12,7 @@ ctest --preset release -j"$jobs"
 cmake --preset asan-ubsan >/dev/null
 cmake --build --preset asan-ubsan --target focal focal_unit_tests -- -j"$jobs"
 ctest --preset asan-ubsan -j"$jobs" -L quick
+cmake --preset clang-release >/dev/null
+cmake --build --preset clang-release -- -j"$jobs"   # the preset's targets: focal, focal_golden_tests
+ctest --preset clang-release -j"$jobs"              # the preset's filter: label golden
 echo "test: all suites passed"

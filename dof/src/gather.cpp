@@ -156,13 +156,16 @@ inline float sampleWeight(float r_p, float i_p, float behind_p, float leak_c, fl
 // Adds the samples at one offset k (|k| = dist) to a row of n centres: the inner loop of the §5
 // pseudo-code, run for n centres at once. Per centre the terms are added in the same order, with
 // the same operations, as gatherReference adds them: the SSE2 lanes are the scalar loop's
-// iterations (no FMA: the build uses -ffp-contract=off, and no intrinsic here fuses).
+// iterations (no FMA: the build uses -ffp-contract=off, and no intrinsic here fuses). Without
+// `simd` every centre takes the scalar loop.
 void addSamples(const float* r_s, const float* i_s, const float* b_s, const float* c_s,
-                const float* leak_c, float dist, uint32_t n, float* wsum, float* nsum, float* acc) {
+                const float* leak_c, float dist, uint32_t n, float* wsum, float* nsum, float* acc,
+                bool simd) {
     uint32_t x = 0;
 #if defined(__SSE2__) && !defined(FOCAL_NO_SIMD)
+    const uint32_t lanes = simd ? n : 0; // centres the SSE2 loop may take
     const __m128 vdist = _mm_set1_ps(dist), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-    for (; x + 4 <= n; x += 4) {
+    for (; x + 4 <= lanes; x += 4) {
         const __m128 t = _mm_sub_ps(_mm_loadu_ps(r_s + x), vdist);
         const __m128 o = _mm_min_ps(_mm_max_ps(t, zero), one);
         const __m128 b = _mm_loadu_ps(b_s + x);
@@ -182,6 +185,8 @@ void addSamples(const float* r_s, const float* i_s, const float* b_s, const floa
         _mm_storeu_ps(a + 12,
                       _mm_add_ps(_mm_loadu_ps(a + 12), _mm_mul_ps(w3, _mm_loadu_ps(c + 12))));
     }
+#else
+    (void)simd;
 #endif
     for (; x < n; ++x) {
         const float w = sampleWeight(r_s[x], i_s[x], b_s[x], leak_c[x], dist);
@@ -425,7 +430,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
                     const size_t srow = size_t(ys) * p.width + x0;
                     const float dist = float(std::abs(k));
                     addSamples(radius + srow, inten + srow, behind + srow, image.rgba + srow * 4,
-                               leak_c, dist, n, wsum, nsum, acc);
+                               leak_c, dist, n, wsum, nsum, acc, settings.simd);
                 }
                 samples += uint64_t(n) * 2 * k_max;
                 float* out = ws.vertical.data() + row * 4;
@@ -495,7 +500,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
                 const float dist = float(std::abs(k));
                 const size_t off = size_t(int(k_max) + k);
                 addSamples(pr + off, pi + off, pb + off, pc + off * 4, leak_c, dist, n, wsum, nsum,
-                           acc);
+                           acc, settings.simd);
             }
             samples += uint64_t(n) * 2 * k_max;
             for (uint32_t x = 0; x < n; ++x)

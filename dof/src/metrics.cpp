@@ -1,6 +1,8 @@
 #include <dof/metrics.h>
+#include <raster/check.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -15,9 +17,9 @@ namespace {
 void rgbOf(const ImageRef& img, size_t i, double out[3]) {
     const float* p = img.pixels + i * img.channels;
     if (img.channels >= 3) {
-        out[0] = p[0], out[1] = p[1], out[2] = p[2];
+        out[0] = double(p[0]), out[1] = double(p[1]), out[2] = double(p[2]);
     } else {
-        out[0] = out[1] = out[2] = p[0];
+        out[0] = out[1] = out[2] = double(p[0]);
     }
 }
 
@@ -163,6 +165,23 @@ raster::Result<ErrorMetrics> compareImages(const ImageRef& a, const ImageRef& b,
     m.ssim = m.ssim_windows ? ssim_sum / double(m.ssim_windows)
                             : std::numeric_limits<double>::quiet_NaN();
     return m;
+}
+
+uint64_t countDifferingPixels(const ImageRef& a, const ImageRef& b, float tolerance) {
+    FOCAL_CHECK(a.width == b.width && a.height == b.height);
+    const uint32_t channels = std::min(a.channels, b.channels);
+    const size_t n = size_t(a.width) * a.height;
+    uint64_t differing = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const float* pa = a.pixels + i * a.channels;
+        const float* pb = b.pixels + i * b.channels;
+        bool differs = false;
+        for (uint32_t c = 0; c < channels && !differs; ++c)
+            differs = std::bit_cast<uint32_t>(pa[c]) != std::bit_cast<uint32_t>(pb[c]) &&
+                      !(std::fabs(pa[c] - pb[c]) <= tolerance);
+        differing += differs;
+    }
+    return differing;
 }
 
 std::vector<uint8_t> discontinuityBand(const ImageRef& depth, float relative_jump,

@@ -73,8 +73,8 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
 void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_height) {
     const double n = std::ldexp(1.0, int(level.index)); // 2^S point samples per axis
     level.filter_variance = (n * n - 1.0) / 12.0;       // discrete box of 2^S samples
-    const double vx = lookupVariance(level.origin_x, level.spacing, base_width);
-    const double vy = lookupVariance(level.origin_y, level.spacing, base_height);
+    const double vx = lookupVariance(double(level.origin_x), double(level.spacing), base_width);
+    const double vy = lookupVariance(double(level.origin_y), double(level.spacing), base_height);
     level.lookup_variance = 0.5 * (vx + vy);
 }
 
@@ -262,8 +262,9 @@ FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& gr
             my += w * (double(b) - mid) * (double(b) - mid);
         }
     level.filter_variance = 0.5 * (mx + my) * tap_px * tap_px + (tap_px * tap_px - 1.0) / 12.0;
-    level.lookup_variance = 0.5 * (lookupVariance(level.origin_x, level.spacing, base_width) +
-                                   lookupVariance(level.origin_y, level.spacing, base_height));
+    level.lookup_variance =
+        0.5 * (lookupVariance(double(level.origin_x), double(level.spacing), base_width) +
+               lookupVariance(double(level.origin_y), double(level.spacing), base_height));
     return level;
 }
 

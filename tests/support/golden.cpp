@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <fcntl.h>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <sys/file.h>
 #include <system_error>
@@ -190,14 +191,20 @@ bool updatingGoldens() {
     return v && *v && std::string(v) != "0";
 }
 
-fs::path goldenDir() {
-    return fs::path(FOCAL_SOURCE_DIR) / "tests" / "golden";
+const GoldenStore& pinholeGoldens() {
+    static const GoldenStore store{
+        fs::path(FOCAL_SOURCE_DIR) / "tests" / "golden",
+        "64-bit FNV-1a of the colour floats and the stored depth of each\n"
+        "# golden case (hashFrame in tests/support/test_util.h)"};
+    return store;
 }
-fs::path goldenHashFile() {
-    return goldenDir() / "hashes.txt";
-}
-fs::path goldenImagePath(const std::string& name) {
-    return goldenDir() / "images" / (name + ".png");
+
+const GoldenStore& dofGoldens() {
+    static const GoldenStore store{
+        fs::path(FOCAL_SOURCE_DIR) / "tests" / "golden" / "dof",
+        "`focal hash` (docs/hash.md) of the EXR that `focal render`\n"
+        "# writes for each golden case (tests/golden/dof_golden_test.cpp)"};
+    return store;
 }
 
 fs::path goldenDiffDir() {
@@ -234,18 +241,18 @@ std::map<std::string, uint64_t> readGoldenHashes(const fs::path& file,
     return hashes;
 }
 
-void updateGoldenHashes(const fs::path& file, const std::map<std::string, uint64_t>& set,
+void updateGoldenHashes(const GoldenStore& store, const std::map<std::string, uint64_t>& set,
                         const std::vector<std::string>& remove) {
     const FileLock lock(fs::temp_directory_path() / "focal-golden-hashes.lock");
+    const fs::path file = store.hashFile();
     std::map<std::string, uint64_t> hashes = readGoldenHashes(file);
     for (const auto& [name, h] : set)
         hashes[name] = h;
     for (const std::string& name : remove)
         hashes.erase(name);
     std::ostringstream text;
-    text << "# focal golden hashes: 64-bit FNV-1a of the colour floats and the stored depth of "
-            "each\n"
-            "# golden case (hashFrame in tests/support/test_util.h), one 'NAME HEX' per line.\n"
+    text << "# focal golden hashes: " << store.hash_definition
+         << ", one 'NAME HEX' per line.\n"
             "# Compared exactly. Do not edit by hand; regenerate with\n"
             "#   "
          << kGoldenUpdateCommand << "\n# and read docs/testing.md first.\n";
@@ -272,13 +279,13 @@ std::vector<uint8_t> toSrgb8(const raster::Frame& frame) {
     return bytes;
 }
 
-::testing::AssertionResult matchesGolden(const std::string& name, const raster::Frame& frame) {
-    const uint64_t actual_hash = hashFrame(frame);
+::testing::AssertionResult matchesGolden(const GoldenStore& store, const std::string& name,
+                                         const raster::Frame& frame, uint64_t actual_hash) {
     const std::vector<uint8_t> actual = toSrgb8(frame);
-    const fs::path image_path = goldenImagePath(name);
+    const fs::path image_path = store.imagePath(name);
 
     if (updatingGoldens()) {
-        updateGoldenHashes(goldenHashFile(), {{name, actual_hash}});
+        updateGoldenHashes(store, {{name, actual_hash}});
         Rgba8 old;
         std::string error;
         fs::create_directories(image_path.parent_path());
@@ -290,7 +297,7 @@ std::vector<uint8_t> toSrgb8(const raster::Frame& frame) {
     }
 
     std::vector<std::string> errors;
-    const std::map<std::string, uint64_t> hashes = readGoldenHashes(goldenHashFile(), &errors);
+    const std::map<std::string, uint64_t> hashes = readGoldenHashes(store.hashFile(), &errors);
     const auto it = hashes.find(name);
     const bool hash_ok = it != hashes.end() && it->second == actual_hash;
 
@@ -323,10 +330,10 @@ std::vector<uint8_t> toSrgb8(const raster::Frame& frame) {
     for (const std::string& e : errors)
         msg << "  " << e << "\n";
     if (it == hashes.end())
-        msg << "  hash: no entry for '" << name << "' in " << goldenHashFile().string() << "\n";
+        msg << "  hash: no entry for '" << name << "' in " << store.hashFile().string() << "\n";
     else if (!hash_ok)
         msg << "  hash: expected " << hex(it->second) << ", got " << hex(actual_hash)
-            << " (colour floats or stored depth changed)\n";
+            << " (the colour, or a pinhole golden's stored depth, changed)\n";
     if (!image_error.empty()) {
         msg << "  image: " << image_error << "\n";
     } else {
@@ -350,6 +357,61 @@ std::vector<uint8_t> toSrgb8(const raster::Frame& frame) {
     msg << "  If the change to the pixels is intended, regenerate with " << kGoldenUpdateCommand
         << " and say why in the commit (docs/testing.md).";
     return ::testing::AssertionFailure() << msg.str();
+}
+
+::testing::AssertionResult
+variantsDiffer(const GoldenStore& store,
+               std::span<const std::pair<const char*, const char*>> pairs) {
+    const std::map<std::string, uint64_t> hashes = readGoldenHashes(store.hashFile());
+    std::ostringstream msg;
+    for (const auto& [a, b] : pairs) {
+        if (!hashes.count(a) || !hashes.count(b))
+            msg << "no golden hash for " << a << " or " << b << "\n";
+        else if (hashes.at(a) == hashes.at(b))
+            msg << a << " and " << b << " render the same bits\n";
+    }
+    if (msg.str().empty())
+        return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << msg.str();
+}
+
+::testing::AssertionResult holdsExactly(const GoldenStore& store,
+                                        const std::vector<std::string>& names) {
+    const std::set<std::string> known(names.begin(), names.end());
+    std::vector<std::string> errors;
+    const auto hashes = readGoldenHashes(store.hashFile(), &errors);
+    std::vector<std::string> stale_hashes;
+    for (const auto& [name, h] : hashes)
+        if (!known.count(name))
+            stale_hashes.push_back(name);
+    std::vector<fs::path> stale_images;
+    std::error_code ec;
+    for (const fs::directory_entry& e : fs::directory_iterator(store.dir / "images", ec))
+        if (e.path().extension() != ".png" || !known.count(e.path().stem().string()))
+            stale_images.push_back(e.path());
+
+    if (updatingGoldens()) {
+        updateGoldenHashes(store, {}, stale_hashes);
+        for (const fs::path& p : stale_images)
+            fs::remove(p, ec);
+        return ::testing::AssertionSuccess();
+    }
+    std::ostringstream msg;
+    for (const std::string& e : errors)
+        msg << e << "\n";
+    for (const std::string& name : stale_hashes)
+        msg << store.hashFile().string() << ": entry '" << name << "' has no case\n";
+    for (const fs::path& p : stale_images)
+        msg << p.string() << ": no case of that name\n";
+    for (const std::string& name : known) {
+        if (!hashes.count(name))
+            msg << "no golden hash for " << name << " in " << store.hashFile().string() << "\n";
+        if (!fs::exists(store.imagePath(name), ec))
+            msg << "no golden image " << store.imagePath(name).string() << "\n";
+    }
+    if (msg.str().empty())
+        return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << msg.str() << "run " << kGoldenUpdateCommand;
 }
 
 } // namespace focal::test

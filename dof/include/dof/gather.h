@@ -76,6 +76,10 @@ struct GatherSettings {
     // half a pixel, and bound each row's loop by the largest CoC that can reach it. Off: the
     // plain per-pixel loop over the whole reach (the reference path; same bits).
     bool skip_tiles = true;
+    // Add four centres' samples at once in SSE2 lanes where the build has them (x86-64 without
+    // FOCAL_NO_SIMD). Off: the scalar loop alone, the reference the lanes reproduce bit for bit.
+    // `focal render --no-simd`.
+    bool simd = true;
 };
 
 // Rejects NaN, R outside [1, 256], leak_scale < 0, min_radius outside (0, 1], bad tile sizes.

@@ -46,6 +46,11 @@ constexpr double kSsimK2 = 0.03;
 raster::Result<ErrorMetrics> compareImages(const ImageRef& a, const ImageRef& b,
                                            const std::vector<uint8_t>* mask = nullptr);
 
+// The pixels where `a` and `b` (same size) differ by more than `tolerance` in some channel,
+// alpha included (channels beyond the smaller count are ignored). Samples with equal bits never
+// differ; a NaN differs from anything but its own bits. Values as stored (linear, unclamped).
+uint64_t countDifferingPixels(const ImageRef& a, const ImageRef& b, float tolerance);
+
 // Depth-discontinuity band. A pixel is an edge pixel when one of its 4-neighbours' depths
 // differs by more than `relative_jump` times the smaller of the two (infinite or non-positive
 // depth, i.e. background, differs from any finite depth). The band is every pixel within

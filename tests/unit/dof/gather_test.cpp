@@ -267,11 +267,14 @@ TEST(Gather, FastPathEqualsTheScalarReference) {
             GatherSettings s;
             s.max_radius_px = radius;
             s.tile_size = 16;
-            std::vector<float> fast, ref;
+            std::vector<float> fast, scalar, ref;
             const dof::ThinLens lens = dof::makeThinLens(view, 6.0f, kFocus);
             ASSERT_TRUE(dof::gather(imageOf(f), lens, view, s, fast).ok());
+            s.simd = false; // the tiled path without its SSE2 lanes
+            ASSERT_TRUE(dof::gather(imageOf(f), lens, view, s, scalar).ok());
             ASSERT_TRUE(dof::gatherReference(imageOf(f), lens, view, s, ref).ok());
             EXPECT_EQ(hashFloats(fast), hashFloats(ref)) << "R = " << radius;
+            EXPECT_EQ(hashFloats(scalar), hashFloats(ref)) << "R = " << radius;
         }
     }
 }

@@ -101,6 +101,8 @@ TEST_F(RenderLensCli, AccumRecordsTheLensInStats) {
     ASSERT_TRUE(fs::exists(out) && fs::exists(depth));
     std::ifstream in(stats);
     const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["schema"], "focal.render-stats");
+    EXPECT_EQ(j["schema_version"], 1);
     EXPECT_NEAR(j["lens"]["aperture_radius"].get<double>(), 0.05 / 2.8, 1e-6);
     EXPECT_EQ(j["lens"]["aperture_source"], "fstop");
     EXPECT_EQ(j["lens"]["focus_source"], "focus-pixel");
@@ -118,6 +120,8 @@ TEST_F(RenderLensCli, AccumRecordsTheLensInStats) {
     ProcessResult same = focal({"compare", out, out, "--json"});
     ASSERT_EQ(same.exit_code, 0) << same.err;
     const nlohmann::json sj = nlohmann::json::parse(same.out);
+    EXPECT_EQ(sj["schema"], "focal.compare");
+    EXPECT_EQ(sj["schema_version"], 1);
     EXPECT_TRUE(sj["all"]["psnr_linear_db"].is_null());
     EXPECT_EQ(sj["all"]["ssim"], 1.0);
     ProcessResult text = focal({"compare", out, out});
@@ -141,11 +145,12 @@ TEST_F(RenderLensCli, CompareErrors) {
     ProcessResult r = focal({"compare", a, b});
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("same size"), std::string::npos) << r.err;
+    // I/O errors exit 2: 1 is kept for "the images are not within the gate".
     r = focal({"compare", a, path("nope.exr")});
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("not found"), std::string::npos) << r.err;
     r = focal({"compare", a, a, "--diff", path("no/such/dir/d.png")});
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2);
     r = focal({"compare", a});
     EXPECT_EQ(r.exit_code, 2);
 }

@@ -2,7 +2,8 @@
 // docs/testing.md). Each case renders a scene at 160x120 from its default camera with one set of
 // RenderOptions. Golden.MatchesReference compares the render with tests/golden (hash exactly,
 // PNG within 1 step); Determinism.SameBitsForEveryThreadCountAndTileSize renders it at threads
-// 0/1/2/3/8 x tiles 16/32/64/128 and requires bit-identical colour and depth.
+// 0/1/2/3/8 x tiles 8/16/64/256 x SIMD/scalar kernels and requires bit-identical colour and
+// depth. The depth-of-field methods have their own goldens (dof_golden_test.cpp).
 #include "apps/scene_source.h"
 #include "support/golden.h"
 #include "support/subprocess.h"
@@ -19,7 +20,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <ostream>
-#include <set>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -32,7 +32,7 @@ using focal::test::matchesGolden;
 constexpr uint32_t kWidth = 160;
 constexpr uint32_t kHeight = 120;
 constexpr uint32_t kThreadCounts[] = {0, 1, 2, 3, 8};
-constexpr uint32_t kTileSizes[] = {16, 32, 64, 128};
+constexpr uint32_t kTileSizes[] = {8, 16, 64, 256};
 
 struct GoldenCase {
     std::string name;  // hash key and image file stem
@@ -134,11 +134,12 @@ TEST_P(Golden, MatchesReference) {
     const raster::Frame frame = focal::test::render(scene, defaultView(scene), c.options, 2);
     ASSERT_EQ(frame.width, kWidth);
     ASSERT_EQ(frame.height, kHeight);
-    EXPECT_TRUE(matchesGolden(c.name, frame));
+    EXPECT_TRUE(
+        matchesGolden(focal::test::pinholeGoldens(), c.name, frame, focal::test::hashFrame(frame)));
 }
 
-// One Renderer (and one reused Frame) per thread count renders every tile size in turn, so
-// reusing per-frame memory between renders is covered too.
+// One Renderer (and one reused Frame) per thread count renders every tile size with both kernel
+// sets in turn, so reusing per-frame memory between renders is covered too.
 TEST_P(Determinism, SameBitsForEveryThreadCountAndTileSize) {
     const GoldenCase& c = GetParam();
     const raster::Scene scene = loadScene(c.scene, c.options.shading);
@@ -153,20 +154,22 @@ TEST_P(Determinism, SameBitsForEveryThreadCountAndTileSize) {
         raster::TaskPool pool(threads);
         raster::Renderer renderer(pool);
         raster::Frame frame;
-        for (const uint32_t tile : kTileSizes) {
-            raster::RenderOptions options = c.options;
-            options.tile_size = tile;
-            const raster::Status s = renderer.render(scene, view, options, frame);
-            ASSERT_TRUE(s.ok()) << s.message();
-            const uint64_t h = focal::test::hashFrame(frame);
-            if (h == reference_hash)
-                continue;
-            const std::string label =
-                c.name + "_threads" + std::to_string(threads) + "_tile" + std::to_string(tile);
-            ADD_FAILURE() << c.name << ": threads " << threads << ", tile " << tile << " gave hash "
-                          << hex(h) << ", threads 0, tile 64 gave " << hex(reference_hash) << "\n"
-                          << focal::test::describeFrameDifference(label, reference, frame);
-        }
+        for (const uint32_t tile : kTileSizes)
+            for (const bool simd : {true, false}) {
+                raster::RenderOptions options = c.options;
+                options.tile_size = tile;
+                options.simd = simd;
+                const raster::Status s = renderer.render(scene, view, options, frame);
+                ASSERT_TRUE(s.ok()) << s.message();
+                const uint64_t h = focal::test::hashFrame(frame);
+                if (h == reference_hash)
+                    continue;
+                const std::string label = c.name + "_threads" + std::to_string(threads) + "_tile" +
+                                          std::to_string(tile) + (simd ? "" : "_scalar");
+                ADD_FAILURE() << label << " gave hash " << hex(h) << ", threads 0, tile 64 gave "
+                              << hex(reference_hash) << "\n"
+                              << focal::test::describeFrameDifference(label, reference, frame);
+            }
     }
 }
 
@@ -180,41 +183,10 @@ INSTANTIATE_TEST_SUITE_P(Scenes, Determinism, ::testing::ValuesIn(goldenCases())
 // The hash file has one valid line per case and tests/golden/images one PNG per case, nothing
 // stale. With FOCAL_UPDATE_GOLDENS=1 stale entries and images are removed instead.
 TEST(GoldenFiles, HoldExactlyTheKnownCases) {
-    std::set<std::string> names;
+    std::vector<std::string> names;
     for (const GoldenCase& c : goldenCases())
-        names.insert(c.name);
-    std::vector<std::string> errors;
-    const auto hashes = focal::test::readGoldenHashes(focal::test::goldenHashFile(), &errors);
-    EXPECT_TRUE(errors.empty()) << ::testing::PrintToString(errors);
-
-    std::vector<std::string> stale_hashes;
-    for (const auto& [name, h] : hashes)
-        if (!names.count(name))
-            stale_hashes.push_back(name);
-    std::vector<fs::path> stale_images;
-    std::error_code ec;
-    for (const fs::directory_entry& e :
-         fs::directory_iterator(focal::test::goldenDir() / "images", ec))
-        if (e.path().extension() != ".png" || !names.count(e.path().stem().string()))
-            stale_images.push_back(e.path());
-
-    if (focal::test::updatingGoldens()) {
-        focal::test::updateGoldenHashes(focal::test::goldenHashFile(), {}, stale_hashes);
-        for (const fs::path& p : stale_images)
-            fs::remove(p, ec);
-        return;
-    }
-    EXPECT_TRUE(stale_hashes.empty())
-        << "entries without a case in " << focal::test::goldenHashFile().string() << ": "
-        << ::testing::PrintToString(stale_hashes) << "; run " << focal::test::kGoldenUpdateCommand;
-    EXPECT_TRUE(stale_images.empty())
-        << "files without a case: " << ::testing::PrintToString(stale_images) << "; run "
-        << focal::test::kGoldenUpdateCommand;
-    for (const std::string& name : names) {
-        EXPECT_TRUE(hashes.count(name)) << "no golden hash for " << name;
-        EXPECT_TRUE(fs::exists(focal::test::goldenImagePath(name)))
-            << "no golden image for " << name;
-    }
+        names.push_back(c.name);
+    EXPECT_TRUE(focal::test::holdsExactly(focal::test::pinholeGoldens(), names));
 }
 
 // Each option a variant case sets changes the pixels of its scene, so the variants test
@@ -222,11 +194,7 @@ TEST(GoldenFiles, HoldExactlyTheKnownCases) {
 TEST(GoldenFiles, VariantsDifferFromTheirBase) {
     if (focal::test::updatingGoldens())
         GTEST_SKIP() << "goldens are being rewritten";
-    const auto hashes = focal::test::readGoldenHashes(focal::test::goldenHashFile());
-    for (const auto& [a, b] : kMustDiffer) {
-        ASSERT_TRUE(hashes.count(a) && hashes.count(b)) << a << ", " << b;
-        EXPECT_NE(hashes.at(a), hashes.at(b)) << a << " and " << b << " render the same bits";
-    }
+    EXPECT_TRUE(focal::test::variantsDiffer(focal::test::pinholeGoldens(), kMustDiffer));
 }
 
 // The command line renders exactly the golden image: same default view, same PNG encoding,
@@ -247,14 +215,12 @@ TEST(GoldenCli, RenderWritesTheGoldenImage) {
     std::vector<uint8_t> cli, golden;
     std::string error;
     ASSERT_TRUE(focal::test::readPngRgba8(out, w, h, cli, error)) << error;
-    ASSERT_TRUE(
-        focal::test::readPngRgba8(focal::test::goldenImagePath("demo"), gw, gh, golden, error))
-        << error;
+    const fs::path golden_png = focal::test::pinholeGoldens().imagePath("demo");
+    ASSERT_TRUE(focal::test::readPngRgba8(golden_png, gw, gh, golden, error)) << error;
     EXPECT_EQ(w, gw);
     EXPECT_EQ(h, gh);
     EXPECT_TRUE(cli == golden) << "focal render wrote " << out.string()
-                               << ", which differs from the golden image "
-                               << focal::test::goldenImagePath("demo").string();
+                               << ", which differs from the golden image " << golden_png.string();
     if (!HasFailure())
         fs::remove_all(dir);
 }
