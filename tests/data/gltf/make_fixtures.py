@@ -4,7 +4,7 @@
 Run from anywhere: python3 tests/data/gltf/make_fixtures.py
 valid/   files that must import, with the values the tests check;
 bad/     one malformed file per error case (the expected message is in the test's table);
-../../fuzz/corpus/gltf/   seeds for the importer's fuzzer that reach KHR_mesh_quantization,
+../../fuzz/corpus/gltf_import/   seeds for the importer's fuzzer that reach KHR_mesh_quantization,
          matrix accessors and the non-finite checks (tests/fuzz, docs/testing.md).
 """
 import base64
@@ -21,7 +21,7 @@ BAD = os.path.join(HERE, "bad")
 
 FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
 BYTE, SHORT = 5120, 5122
-FUZZ_SEEDS = os.path.join(HERE, "..", "..", "fuzz", "corpus", "gltf")
+FUZZ_SEEDS = os.path.join(HERE, "..", "..", "fuzz", "corpus", "gltf_import")
 
 
 # --- tiny PNG writer -------------------------------------------------------------------------
