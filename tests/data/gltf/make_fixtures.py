@@ -588,8 +588,24 @@ def make_fuzz_seeds():
     g.doc["scenes"] = [{"nodes": [0, 1]}]
     save("matrix_accessors.gltf", g.finish())
 
-    # Non-finite numbers where JSON can spell them (1e999 parses as infinity): factors, a node
-    # transform, a camera, a light, a texture transform; NaN in vertex data.
+    # Non-finite numbers. JSON has none, and the parser refuses 1e999 (non_finite_json.gltf),
+    # so they come from finite numbers that overflow: a node scale of 3e38 under which a mesh,
+    # a camera and a light sit (world matrices of inf), 3e38 factors; and NaN in vertex data.
+    g = triangle_doc()
+    d = g.finish()
+    d["nodes"] = [{"scale": [3e38, 3e38, 3e38], "children": [1, 2, 3]},
+                  {"mesh": 0, "translation": [3e38, 0, 0]},
+                  {"camera": 0, "translation": [0, 0, 3e38]},
+                  {"extensions": {"KHR_lights_punctual": {"light": 0}}}]
+    d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 3.14159, "znear": 1e-38}}]
+    d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 3e38,
+                                                           "color": [3e38, 3e38, 3e38]}]}}
+    d["materials"] = [{"pbrMetallicRoughness": {"baseColorFactor": [3e38, 3e38, 0, 1]},
+                       "emissiveFactor": [3e38, 0, 0]}]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    d["scenes"] = [{"nodes": [0]}]
+    save("non_finite.gltf", d)
     g = triangle_doc()
     d = g.finish()
     d["materials"] = [{"pbrMetallicRoughness": {"baseColorFactor": [1e999, 0, 0, 1],
@@ -605,7 +621,7 @@ def make_fuzz_seeds():
                                                            "spot": {"outerConeAngle": 1e999}}]}}
     d["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}})
     d["scenes"] = [{"nodes": [0, 1, 2]}]
-    save("non_finite.gltf", d)
+    save("non_finite_json.gltf", d)
     g = Gltf()
     pos = g.accessor([(0, 0, 0), (math.nan, 0, 0), (0, math.inf, 0)], FLOAT, "VEC3")
     g.doc["meshes"] = [{"primitives": [{"attributes": {"POSITION": pos}}]}]
