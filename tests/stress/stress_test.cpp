@@ -116,12 +116,14 @@ void addQuad(std::vector<Triangle>& tris, float x0, float y0, float x1, float y1
 
 // The stage, in units where the eye is at the origin looking down -z: a back wall at d = 20 in
 // two colours, a green square at d = 10 (where the lens focuses) and a white one at d = 4.
-std::string stageGltf(double offset, double scale) {
+std::string stageGltf(double offset, double scale, bool squares = true) {
     std::vector<Triangle> t;
     addQuad(t, -30, -20, 0, 20, -20, 0);
     addQuad(t, 0, -20, 30, 20, -20, 1);
-    addQuad(t, -2, -2, 2, 2, -10, 2);
-    addQuad(t, -1.6f, 0.2f, -0.6f, 1.2f, -4, 3);
+    if (squares) {
+        addQuad(t, -2, -2, 2, 2, -10, 2);
+        addQuad(t, -1.6f, 0.2f, -0.6f, 1.2f, -4, 3);
+    }
     return gltfOf(t, {{0.8f, 0.1f, 0.1f}, {0.1f, 0.2f, 0.9f}, {0.1f, 0.8f, 0.2f}, {1, 1, 1}},
                   offset, scale);
 }
@@ -156,6 +158,7 @@ public:
         write("stage_small.gltf", stageGltf(0.0, 1e-4));
         write("stage_large.gltf", stageGltf(0.0, 1e4));
         write("sliver_huge.gltf", sliverHugeGltf());
+        write("wall.gltf", stageGltf(0.0, 1.0, false));
     }
     ~StressDir() { fs::remove_all(dir_); }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
@@ -215,6 +218,7 @@ enum class Expect {
     Image,       // exit 0, finite, same bits for threads 0 / 3 and tiles 64 / 16
     Error,       // exit 1, one "focal: error:" line containing `message`, no file
     WarnedImage, // Image, plus a "focal: warning:" line containing `message`
+    SameMean,    // Image, and its mean within 1% of the reference's (blur moves light only)
 };
 
 struct StressCase {
@@ -240,7 +244,7 @@ const char* kSize[] = {"--width", "64", "--height", "48"};
 // square at 10. Options given later in a case override none of these (CLI11 takes one value), so
 // cases that change them build their own list.
 std::vector<std::string> stageArgs(const std::string& scene, double offset, double scale, bool lens,
-                                   double near = 0.1, double aperture = 0.05, double focus = 10.0) {
+                                   double near = 0.1, double aperture = 0.5, double focus = 10.0) {
     const std::string o = number(offset);
     std::vector<std::string> a = {scene,
                                   "--eye",
@@ -265,7 +269,7 @@ std::vector<StressCase> stressCases() {
     for (const std::string& m : methods) {
         const bool lens = m != "pinhole";
         const std::vector<std::string> method = {"--method", m, "--samples", "16"};
-        auto stage = [&](double offset, double scale, double near = 0.1, double aperture = 0.05,
+        auto stage = [&](double offset, double scale, double near = 0.1, double aperture = 0.5,
                          double focus = 10.0) {
             std::vector<std::string> a = stageArgs(offset == 0.0 && scale == 1.0 ? "stage.gltf"
                                                    : offset != 0.0 ? "stage_offset.gltf"
@@ -321,24 +325,33 @@ std::vector<StressCase> stressCases() {
             cases.push_back({"aperture_1e3", m,
                              with(stage(0, 1, 0.1, 1e3), {"--memory-budget", "4G"}), Expect::Error,
                              "filter levels for a CoC of up to", "", 0,
-                             "aperture radius 1e3: CoC up to ~580,000 px, 4 GiB budget"});
+                             "aperture radius 1e3: CoC up to 8,700 px, 4 GiB budget"});
         } else {
             cases.push_back({"aperture_1e3", m, stage(0, 1, 0.1, 1e3), Expect::Image, "", "", 0,
-                             "aperture radius 1e3: CoC up to ~580,000 px"});
+                             "aperture radius 1e3: CoC up to 8,700 px"});
         }
-        cases.push_back({"coc_600px", m, stage(0, 1, 0.1, 1.0), Expect::Image, "", "", 0,
-                         "aperture 1: CoC ~600 px at the near square"});
-        cases.push_back({"focus_at_near", m, stage(0, 1, 0.1, 0.05, 0.1), Expect::Image, "", "", 0,
+        cases.push_back({"coc_600px", m, stage(0, 1, 0.1, 70.0), Expect::Image, "", "", 0,
+                         "aperture 70: CoC 610 px at the near square, 200 px at the wall"});
+        // The wall alone: in focus it must stay the pinhole image; out of focus its mean
+        // colour must stay (the blur only moves light).
+        cases.push_back(
+            {"in_focus_wall", m, with(stageArgs("wall.gltf", 0, 1, true, 0.1, 0.5, 20.0), method),
+             Expect::Image, "", "wall pinhole", 1e-3, "focus exactly on the wall: stays sharp"});
+        cases.push_back({"energy_wall", m,
+                         with(stageArgs("wall.gltf", 0, 1, true, 0.1, 0.5, 5.0), method),
+                         Expect::SameMean, "", "wall pinhole", 1.0,
+                         "wall defocused (CoC 4.3 px): mean colour conserved within 1%"});
+        cases.push_back({"focus_at_near", m, stage(0, 1, 0.1, 0.5, 0.1), Expect::Image, "", "", 0,
                          "focus distance = near plane"});
-        cases.push_back({"focus_on_wall", m, stage(0, 1, 0.1, 0.05, 20.0), Expect::Image, "", "", 0,
+        cases.push_back({"focus_on_wall", m, stage(0, 1, 0.1, 0.5, 20.0), Expect::Image, "", "", 0,
                          "focus exactly on the back wall (sharp there)"});
-        cases.push_back({"focus_3e38", m, with(stage(0, 1, 0.1, 0.05, 3e38), {"--far", "0"}),
+        cases.push_back({"focus_3e38", m, with(stage(0, 1, 0.1, 0.5, 3e38), {"--far", "0"}),
                          Expect::Image, "", "", 0,
                          "focus at 3e38 (infinity in float), infinite far plane"});
-        cases.push_back({"focus_beyond_far", m, stage(0, 1, 0.1, 0.05, 3e38), Expect::Error,
+        cases.push_back({"focus_beyond_far", m, stage(0, 1, 0.1, 0.5, 3e38), Expect::Error,
                          "lies behind the far plane", "", 0,
                          "focus at 3e38 behind the far plane (41.6)"});
-        cases.push_back({"focus_inf", m, stage(0, 1, 0.1, 0.05, INFINITY), Expect::Error,
+        cases.push_back({"focus_inf", m, stage(0, 1, 0.1, 0.5, INFINITY), Expect::Error,
                          "--focus-distance must be a finite number > 0", "", 0,
                          "focus at infinity"});
         cases.push_back(
@@ -392,38 +405,39 @@ std::vector<StressCase> stressCases() {
                      "",
                      0,
                      "8192x8192 pinhole (dry run)"});
-    cases.push_back(
-        {"image_8192_budget",
-         "pinhole",
-         {"builtin:demo", "--width", "8192", "--height", "8192", "--memory-budget", "1G"},
-         Expect::Error,
-         "--method pinhole at 8192x8192 needs 1.2 GiB, more than the memory budget "
-         "of 1.0 GiB",
-         "",
-         0,
-         "8192x8192 under a 1 GiB budget"});
-    cases.push_back({"absurd_16384_multiview",
-                     "multiview",
-                     {"builtin:demo", "--width", "16384", "--height", "16384", "--method",
-                      "multiview", "--samples", "65536", "--memory-budget", "8G"},
-                     Expect::Error,
-                     "--method multiview at 16384x16384 with 65536 samples needs",
-                     "",
-                     0,
-                     "16384x16384, 65536 samples (issue 23)"});
-    cases.push_back({"layers_64_8k",
-                     "multiview",
-                     {"builtin:demo", "--width", "8192", "--height", "8192", "--method",
-                      "multiview", "--layers", "64", "--memory-budget", "8G"},
-                     Expect::Error,
-                     "--method multiview at 8192x8192 with 64 samples needs",
-                     "",
-                     0,
-                     "64 layers at 8192x8192"});
+    // Requests that cannot be honoured: one error line naming what needed how much.
+    auto refused = [&](const char* name, const char* method, std::vector<std::string> args,
+                       const char* message, const char* what) {
+        cases.push_back({name, method, std::move(args), Expect::Error, message, "", 0, what});
+    };
+    refused("image_8192_budget", "pinhole",
+            {"builtin:demo", "--width", "8192", "--height", "8192", "--memory-budget", "1G"},
+            "--method pinhole at 8192x8192 needs 1.2 GiB, more than the memory budget of 1.0 GiB",
+            "8192x8192 under a 1 GiB budget");
+    refused("absurd_16384_multiview", "multiview",
+            {"builtin:demo", "--width", "16384", "--height", "16384", "--method", "multiview",
+             "--samples", "65536", "--memory-budget", "8G"},
+            "--method multiview at 16384x16384 with 65536 samples needs",
+            "16384x16384, 65536 samples (issue 23)");
+    refused("layers_64_8k", "multiview",
+            {"builtin:demo", "--width", "8192", "--height", "8192", "--method", "multiview",
+             "--layers", "64", "--memory-budget", "8G"},
+            "--method multiview at 8192x8192 with 64 samples needs", "64 layers at 8192x8192");
     return cases;
 }
 
 // --- The test --------------------------------------------------------------------------------
+
+// The arguments of the render a case is compared with (StressCase::reference).
+std::vector<std::string> referenceArgs(const StressCase& c) {
+    if (c.reference == "pinhole")
+        return stageArgs("stage.gltf", 0, 1, false);
+    if (c.reference == "wall pinhole")
+        return stageArgs("wall.gltf", 0, 1, false);
+    std::vector<std::string> a = stageArgs("stage.gltf", 0, 1, c.method != "pinhole"); // base
+    a.insert(a.end(), {"--method", c.method, "--samples", "16"});
+    return a;
+}
 
 // Each case appends its row of the outcome table to stress-results/METHOD_CASE.md (CTest runs
 // every case in its own process); docs/stress.md is `cat stress-results/*.md` of the last run.
@@ -493,21 +507,18 @@ TEST_P(Stress, HoldsItsPromise) {
                           mean(img));
             outcome = text;
             if (!c.reference.empty()) {
-                const bool pinhole = c.reference == "pinhole";
-                const std::string key = (pinhole ? std::string("pinhole") : c.method) + "/base";
-                const std::vector<std::string> base_args =
-                    withSize(pinhole ? stageArgs("stage.gltf", 0, 1, false) : [&] {
-                        std::vector<std::string> a =
-                            stageArgs("stage.gltf", 0, 1, c.method != "pinhole");
-                        a.insert(a.end(), {"--method", c.method, "--samples", "16"});
-                        return a;
-                    }());
-                const ImageData ref = reference(base_args, "reference_" + output);
+                const ImageData ref = reference(withSize(referenceArgs(c)), "reference_" + output);
                 const double diff = meanAbsDiff(img, ref);
-                EXPECT_LE(diff, c.max_mean_diff) << "mean |difference| from " << key;
+                EXPECT_LE(diff, c.max_mean_diff) << "mean |difference| from " << c.reference;
                 std::snprintf(text, sizeof(text), "; mean abs diff from %s %.2e (limit %.0e)",
-                              key.c_str(), diff, c.max_mean_diff);
+                              c.reference.c_str(), diff, c.max_mean_diff);
                 outcome += text;
+                if (c.expect == Expect::SameMean) {
+                    const double shift = std::fabs(mean(img) / mean(ref) - 1.0);
+                    EXPECT_LE(shift, 0.01) << "mean colour moved from " << mean(ref);
+                    std::snprintf(text, sizeof(text), "; mean moved %.2e (limit 1e-02)", shift);
+                    outcome += text;
+                }
             }
         }
         const auto warning = std::find_if(err_lines.begin(), err_lines.end(), [](const auto& l) {
