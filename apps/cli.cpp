@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <new>
 #include <thread>
 
 namespace focal {
@@ -39,6 +40,7 @@ int runInfo(const InfoArgs& args) {
     }
     raster::TaskPool pool(args.threads);
     options.pool = &pool;
+    options.memory_budget = raster::defaultMemoryBudget();
     raster::ImportStats stats;
     raster::Result<raster::Scene> scene = loadScene(args.scene, options, &stats);
     if (!scene.ok()) {
@@ -95,16 +97,24 @@ int runCli(int argc, char** argv) {
         std::fprintf(stderr, "focal: error: %s (see focal --help)\n", e.what());
         return 2;
     }
-    if (render->parsed())
-        return runRender(render_args);
-    if (compare->parsed())
-        return runCompare(compare_args);
-    if (hash->parsed())
-        return runHash(hash_args);
-    if (bench->parsed())
-        return runBench(bench_args);
-    if (info->parsed())
-        return runInfo(info_args);
+    // The budget checks catch what can be foreseen; an allocation that still fails (the machine
+    // is short of memory, or a buffer nobody budgeted) is one error line, never std::terminate.
+    try {
+        if (render->parsed())
+            return runRender(render_args);
+        if (compare->parsed())
+            return runCompare(compare_args);
+        if (hash->parsed())
+            return runHash(hash_args);
+        if (bench->parsed())
+            return runBench(bench_args);
+        if (info->parsed())
+            return runInfo(info_args);
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "focal: error: out of memory (lower --width/--height, --samples or "
+                             "--layers, or set --memory-budget to fail before allocating)\n");
+        return 1;
+    }
     return 2;
 }
 

@@ -59,6 +59,10 @@ struct MethodEntry {
     // args object owned by the entry).
     std::function<void(CLI::App& render)> add_options;
     std::function<raster::Status(const MethodInput&, MethodOutput&)> run;
+    // Optional: a lower bound of the bytes a run holds for `view` with `samples` lens samples on
+    // `workers` workers, checked against --memory-budget before anything is rendered.
+    std::function<uint64_t(const raster::View& view, uint32_t samples, uint32_t workers)>
+        minimum_bytes;
 };
 
 // The methods beyond pinhole and accum, in a fixed order (apps/methods.cpp).

@@ -97,6 +97,7 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     settings.color_format = in.target_color.value_or(raster::ColorFormat::Half);
     settings.depth_format = in.target_depth.value_or(raster::DepthFormat::Float32);
     settings.aperture_second_moment = apertureSecondMoment(in.lens_samples);
+    settings.memory_budget = in.options.memory_budget;
     settings.level_contributions = !args.levels_out.empty();
 
     raster::View pinhole = in.view;

@@ -551,6 +551,14 @@ MethodEntry makeMultiviewMethod() {
     e.run = [args](const MethodInput& in, MethodOutput& out) {
         return runMultiview(*args, in, out);
     };
+    e.minimum_bytes = [args](const raster::View& view, uint32_t samples, uint32_t workers) {
+        dof::MultiviewSettings s;
+        s.layers = args->layers;
+        s.view_dependent = args->view_dependent;
+        s.color_format = raster::ColorFormat::Half; // the smallest storage: a lower bound
+        s.depth_format = raster::DepthFormat::Unorm16;
+        return dof::multiviewMinimumBytes(s, view.width, view.height, samples, workers);
+    };
     return e;
 }
 

@@ -2,6 +2,7 @@
 
 #include "apps/dof_method.h"
 #include "apps/image_io.h"
+#include "apps/memory_option.h"
 #include "apps/scene_source.h"
 #include "apps/target_dumps.h"
 #include "apps/text_file.h"
@@ -11,6 +12,7 @@
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
 #include <raster/camera.h>
+#include <raster/depth_precision.h>
 #include <raster/renderer.h>
 #include <raster/task_pool.h>
 
@@ -228,6 +230,71 @@ private:
     uint32_t last_ = ~0u;
 };
 
+// No silent wrong image: warns, with the numbers, when a depth format cannot hold the distances
+// the scene spans in front of the view (docs/targets.md, "Depth precision"). `targets`: the
+// storage of the layered target / fragment lists when the user chose one.
+void warnDepthPrecision(const raster::Scene& scene, const raster::View& view,
+                        raster::DepthFormat frame_format,
+                        std::optional<raster::DepthFormat> targets, bool table_method) {
+    const raster::Bounds b = raster::worldBounds(scene);
+    if (b.empty)
+        return;
+    float near_d = INFINITY, far_d = -INFINITY;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::vec3 p((corner & 1) ? b.max.x : b.min.x, (corner & 2) ? b.max.y : b.min.y,
+                          (corner & 4) ? b.max.z : b.min.z);
+        const float d = glm::dot(p - view.eye, view.forward);
+        near_d = std::min(near_d, d);
+        far_d = std::max(far_d, d);
+    }
+    near_d = std::max(near_d, view.znear);
+    if (view.zfar > 0.0f)
+        far_d = std::min(far_d, view.zfar);
+    auto warn = [&](raster::DepthFormat format, const char* target) {
+        if (std::optional<std::string> problem =
+                raster::depthPrecisionProblem(view, format, near_d, far_d, target))
+            std::fprintf(stderr, "focal: warning: %s\n", problem->c_str());
+    };
+    warn(frame_format, "depth");
+    if (table_method && targets && *targets != frame_format)
+        warn(*targets, "target depth");
+}
+
+// Focus on the centre of the scene's bounds, when it lies in front of the view.
+std::optional<float> boundsFocusDistance(const raster::Scene& scene, const raster::View& view) {
+    const raster::Bounds b = raster::worldBounds(scene);
+    const float along = glm::dot(0.5f * (b.min + b.max) - view.eye, view.forward);
+    if (b.empty || !(along > 0.0f))
+        return std::nullopt;
+    return along;
+}
+
+// "--method multiview at 16384x16384 with 65536 samples": the request, in messages.
+std::string requestText(const RenderArgs& args, const raster::View& view) {
+    std::string text = "--method " + args.method + " at " + std::to_string(view.width) + "x" +
+                       std::to_string(view.height);
+    if (args.method != "pinhole")
+        text += " with " + std::to_string(args.samples) + " samples";
+    return text;
+}
+
+// The memory a render request needs at least, before anything is rendered: the pinhole frame
+// (autofocus and the lens centre), accum's second frame and its double-precision sum, and what a
+// table method declares (MethodEntry::minimum_bytes).
+uint64_t requestMinimumBytes(const RenderArgs& args, const raster::View& view,
+                             const raster::RenderOptions& options, const MethodEntry* table_method,
+                             uint32_t workers) {
+    const uint32_t w = view.width, h = view.height;
+    uint64_t bytes = raster::frameBytes(w, h, options.depth_format, false);
+    if (args.method == "accum")
+        bytes = raster::addBytes(
+            bytes, raster::addBytes(raster::frameBytes(w, h, options.depth_format, false),
+                                    raster::mulBytes(uint64_t{w} * h, 4 * sizeof(double))));
+    if (table_method && table_method->minimum_bytes)
+        bytes = raster::addBytes(bytes, table_method->minimum_bytes(view, args.samples, workers));
+    return bytes;
+}
+
 } // namespace
 
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
@@ -257,6 +324,20 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     cmd->add_option("--threads", args.threads, "worker threads (0 = run inline on the caller)")
         ->capture_default_str()
         ->check(CLI::Range(0, 256));
+    cmd->add_option("--memory-budget", args.memory_budget,
+                    "the most memory one render may use: auto (half of physical memory), a "
+                    "size (8G, 512MiB) or a percentage of physical memory (25%)")
+        ->capture_default_str()
+        ->check(CLI::Validator(
+            [](const std::string& text) {
+                const Result<raster::MemoryBudget> r = parseMemoryBudget(text);
+                return r.ok() ? std::string() : r.status().message();
+            },
+            "SIZE"));
+    cmd->add_flag("--dry-run", args.dry_run,
+                  "check the options, scene, view, lens and memory budget, print the request "
+                  "and stop: nothing is rendered or written (autofocus falls back to the scene "
+                  "bounds)");
     cmd->add_option("--tile", args.tile, "tile size in pixels (multiple of 8, 8 to 256)")
         ->capture_default_str()
         ->check(CLI::Range(8, 256))
@@ -414,6 +495,7 @@ int runRender(const RenderArgs& args) {
                                  ? raster::FilterOverride::Trilinear
                                  : raster::FilterOverride::Sampler;
     options.simd = !args.no_simd;
+    options.memory_budget = parseMemoryBudget(args.memory_budget).value(); // checked by CLI11
 
     raster::TaskPool pool(args.threads);
 
@@ -421,6 +503,7 @@ int runRender(const RenderArgs& args) {
     raster::ImportOptions import_options;
     import_options.roles = raster::sampledTextureRoles(options.shading);
     import_options.pool = &pool;
+    import_options.memory_budget = options.memory_budget;
     raster::ImportStats load_stats;
     Result<raster::Scene> scene = loadScene(args.scene, import_options, &load_stats);
     if (!scene.ok())
@@ -435,6 +518,29 @@ int runRender(const RenderArgs& args) {
     if (args.focal_length_mm)
         view->yfov = dof::yfovFromFocalLength(*args.focal_length_mm, sensor_mm);
     if (Status s = raster::validate(*view); !s.ok())
+        return fail(s.message());
+    // Target storage for the table's methods.
+    std::optional<raster::ColorFormat> target_color;
+    std::optional<raster::DepthFormat> target_depth;
+    if (args.precision) {
+        target_color =
+            *args.precision == 16 ? raster::ColorFormat::Half : raster::ColorFormat::Float32;
+        target_depth =
+            *args.precision == 16 ? raster::DepthFormat::Unorm16 : raster::DepthFormat::Float32;
+    }
+    if (args.target_color)
+        target_color =
+            *args.target_color == "half" ? raster::ColorFormat::Half : raster::ColorFormat::Float32;
+    if (args.target_depth)
+        target_depth = *args.target_depth == "unorm16" ? raster::DepthFormat::Unorm16
+                                                       : raster::DepthFormat::Float32;
+    warnDepthPrecision(*scene, *view, options.depth_format, target_depth, table_method != nullptr);
+    // Absurd requests fail here, in milliseconds, before any rendering.
+    const uint64_t request_bytes =
+        requestMinimumBytes(args, *view, options, table_method, pool.workerCount());
+    if (Status s =
+            raster::checkMemory(options.memory_budget, requestText(args, *view), request_bytes);
+        !s.ok())
         return fail(s.message());
 
     raster::Renderer renderer(pool);
@@ -470,7 +576,7 @@ int runRender(const RenderArgs& args) {
     if (args.focus_distance) {
         focus_distance = *args.focus_distance;
         choice.focus_source = "cli";
-    } else if (args.focus_pixel || (uses_lens && !look_at && !scene->lens)) {
+    } else if (!args.dry_run && (args.focus_pixel || (uses_lens && !look_at && !scene->lens))) {
         // Render the pinhole (independent of the lens) and read its depth.
         const auto t0 = std::chrono::steady_clock::now();
         raster::View pin = *view;
@@ -493,13 +599,15 @@ int runRender(const RenderArgs& args) {
                    d.ok()) {
             focus_distance = *d;
             choice.focus_source = "autofocus";
-        } else {
-            const raster::Bounds b = raster::worldBounds(*scene);
-            const float along = glm::dot(0.5f * (b.min + b.max) - view->eye, view->forward);
-            if (!b.empty && along > 0.0f) {
-                focus_distance = along;
-                choice.focus_source = "bounds";
-            }
+        } else if (const std::optional<float> bounds_d = boundsFocusDistance(*scene, *view)) {
+            focus_distance = *bounds_d;
+            choice.focus_source = "bounds";
+        }
+    } else if (args.dry_run && (args.focus_pixel || (uses_lens && !look_at && !scene->lens))) {
+        // Autofocus reads a pinhole render, which a dry run does not make.
+        if (const std::optional<float> d = boundsFocusDistance(*scene, *view)) {
+            focus_distance = *d;
+            choice.focus_source = "bounds";
         }
     } else if (look_at) {
         choice.focus_source = "target";
@@ -517,22 +625,18 @@ int runRender(const RenderArgs& args) {
         *aperture_shape, patternOf(args.lens_pattern), uses_lens ? args.samples : 1, args.seed);
     if (!lens_samples.ok())
         return fail(lens_samples.status().message());
-
-    // Target storage for the table's methods.
-    std::optional<raster::ColorFormat> target_color;
-    std::optional<raster::DepthFormat> target_depth;
-    if (args.precision) {
-        target_color =
-            *args.precision == 16 ? raster::ColorFormat::Half : raster::ColorFormat::Float32;
-        target_depth =
-            *args.precision == 16 ? raster::DepthFormat::Unorm16 : raster::DepthFormat::Float32;
+    if (args.dry_run) {
+        std::printf("focal: dry run: %s, aperture radius %g, focus distance %g (%s), needs at "
+                    "least %s of a %s memory budget\n",
+                    requestText(args, *view).c_str(), double(choice.lens.aperture_radius),
+                    double(focus_distance), choice.focus_source.c_str(),
+                    raster::formatBytes(request_bytes).c_str(),
+                    options.memory_budget.limited()
+                        ? raster::formatBytes(options.memory_budget.bytes).c_str()
+                        : "unlimited");
+        return 0;
     }
-    if (args.target_color)
-        target_color =
-            *args.target_color == "half" ? raster::ColorFormat::Half : raster::ColorFormat::Float32;
-    if (args.target_depth)
-        target_depth = *args.target_depth == "unorm16" ? raster::DepthFormat::Unorm16
-                                                       : raster::DepthFormat::Float32;
+
     MethodOutput method_out;
     std::vector<std::pair<std::string, std::vector<double>>> method_stage_ms;
 

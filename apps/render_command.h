@@ -50,6 +50,9 @@ struct RenderArgs {
     uint32_t seed = 0;
     bool no_progress = false;
     bool no_simd = false;
+    std::string memory_budget = "auto"; // apps/memory_option.h
+    // Check the options, scene, view, lens and memory, print the request, render nothing.
+    bool dry_run = false;
     // Looking inside the GPU-emulating targets (docs/targets.md).
     std::string dump_layers;
     uint32_t dump_layer_count = 8;

@@ -8,6 +8,7 @@ packages=(
   libglm-dev libtinygltf-dev libopenimageio-dev libimath-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
   gnuplot-nox
+  clang libclang-rt-14-dev  # the libFuzzer targets (tools/fuzz.sh)
 )
 
 missing=()

@@ -1,6 +1,7 @@
 #include <dof/lens.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace dof {
@@ -34,16 +35,27 @@ float yfovFromFocalLength(float focal_length_mm, float sensor_height_mm) {
     return 2.0f * std::atan(0.5f * sensor_height_mm / focal_length_mm);
 }
 
+namespace {
+
+// 6 significant digits, without the 39 digits std::to_string gives 3e38.
+std::string text(float v) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%g", double(v));
+    return buf;
+}
+
+} // namespace
+
 Status validate(const ThinLens& lens, const raster::View& view) {
     if (!std::isfinite(lens.aperture_radius) || lens.aperture_radius < 0.0f)
         return Status::error("--aperture-radius must be a finite number >= 0 (world units), got " +
-                             std::to_string(lens.aperture_radius));
+                             text(lens.aperture_radius));
     if (!std::isfinite(lens.focus_distance) || lens.focus_distance <= 0.0f)
         return Status::error("--focus-distance must be a finite number > 0 (world units), got " +
-                             std::to_string(lens.focus_distance));
+                             text(lens.focus_distance));
     if (view.zfar > 0.0f && lens.focus_distance > view.zfar)
-        return Status::error("focus distance " + std::to_string(lens.focus_distance) +
-                             " lies behind the far plane (" + std::to_string(view.zfar) +
+        return Status::error("focus distance " + text(lens.focus_distance) +
+                             " lies behind the far plane (" + text(view.zfar) +
                              "); nothing visible could be in focus");
     if (!std::isfinite(lens.focal_length_px) || lens.focal_length_px <= 0.0f)
         return Status::error("focal length in pixels must be finite and > 0");

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -60,6 +61,26 @@ struct Plan {
     std::vector<double> variance; // V_S of T
     double radius(size_t s, double m2) const { return std::sqrt(variance[s] / m2); }
 };
+
+// The planned levels hold up to N fragments per cell (N = fragments_per_pixel, 16 when all are
+// kept): an estimate of what filtering them takes, checked before any level is allocated.
+raster::Status checkLevelMemory(const Plan& plan, const MultilayerSettings& settings,
+                                float max_coc) {
+    uint64_t cells = 0;
+    for (const std::vector<FragmentLevel>* levels : {&plan.boxes, &plan.apertures})
+        for (const FragmentLevel& l : *levels)
+            cells = raster::addBytes(cells, uint64_t{l.width} * l.height);
+    const uint64_t per_cell =
+        sizeof(uint32_t) +
+        uint64_t{settings.fragments_per_pixel == 0 ? 16u : settings.fragments_per_pixel} *
+            sizeof(LayerFragment);
+    char what[160];
+    std::snprintf(what, sizeof(what),
+                  "multilayer: %zu filter levels for a CoC of up to %.0f px (%llu cells)",
+                  plan.boxes.size() + plan.apertures.size(), double(max_coc),
+                  static_cast<unsigned long long>(cells));
+    return raster::checkMemory(settings.memory_budget, what, raster::mulBytes(cells, per_cell));
+}
 
 // T over the boxes: the boxes themselves, or box 0 and then the aperture levels of box 0, 1, ...
 // (one per grid of settings.aperture_grids), each kept only if it blurs more than the previous
@@ -283,6 +304,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
 
     // §5: plan the Y-map and T, compute the border table (§6.1), filter level by level.
     Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
+    if (raster::Status s = checkLevelMemory(plan, settings, max_coc); !s.ok())
+        return s;
     borders_ = levelBorders(lens, plan.variance, m2);
     // Box levels up to the highest one T reads (all of them with box levels).
     uint32_t boxes_needed = uint32_t(plan.boxes.size());

@@ -1771,4 +1771,23 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     return r;
 }
 
+uint64_t multiviewMinimumBytes(const MultiviewSettings& settings, uint32_t width, uint32_t height,
+                               uint32_t sample_count, uint32_t workers) {
+    using raster::addBytes, raster::mulBytes;
+    const uint64_t pixels = uint64_t{width} * height;
+    const uint32_t layers = std::max(settings.layers, 1u);
+    raster::LayeredTargetDesc desc;
+    desc.color_format = settings.color_format;
+    desc.depth_format = settings.depth_format;
+    desc.gbuffer = settings.view_dependent || settings.env_map != nullptr;
+    uint64_t bytes = raster::frameBytes(width, height, raster::DepthFormat::Float32, false);
+    bytes = addBytes(bytes, mulBytes(pixels, 4 * sizeof(float))); // rgba
+    bytes = addBytes(bytes, raster::layeredTargetBytes(width, height, layers, desc, false));
+    bytes = addBytes(bytes, mulBytes(mulBytes(pixels, layers), sizeof(float))); // scratch.depth
+    const uint64_t tile_texels = uint64_t{settings.tile_size} * settings.tile_size;
+    const uint64_t per_texel =
+        addBytes(mulBytes(sample_count, sizeof(RayState)), sizeof(PixelLayers));
+    return addBytes(bytes, mulBytes(mulBytes(workers, tile_texels), per_texel));
+}
+
 } // namespace dof

@@ -39,10 +39,18 @@ namespace {
     } while (0)
 
 // Limits on what a file may make us allocate: images up to 32768 pixels a side and 2^27 pixels
-// (512 MiB as RGBA8); accessors without a bufferView (all zeros) up to 2^24 elements.
+// (512 MiB as RGBA8); accessors without a bufferView (all zeros) up to 2^24 elements each, and
+// in all (every read counts: 16 primitives sharing one such accessor read it 16 times) at most
+// 256 elements per byte the file and its buffers hold, or 2^20 for small files. A zero element
+// costs the import up to 8 bytes per component, so a 300-byte file can no longer ask for GBs.
 constexpr uint32_t kMaxImageSide = 32768;
 constexpr uint64_t kMaxImagePixels = uint64_t{1} << 27;
 constexpr size_t kMaxZeroAccessorCount = size_t{1} << 24;
+constexpr uint64_t kZeroElementsPerSourceByte = 256;
+constexpr uint64_t kMinZeroElementsPerFile = uint64_t{1} << 20;
+// JSON nesting focal parses: glTF itself needs about 8 levels, extras a few more. The JSON
+// parser recurses once per level, so a file nested 15,000 deep overflowed the stack.
+constexpr size_t kMaxJsonDepth = 128;
 
 // Extensions focal implements fully; a file may require any of them.
 constexpr const char* kSupportedExtensions[] = {
@@ -304,9 +312,13 @@ struct AttributeRule {
 
 class Importer {
 public:
+    // source_bytes: the size of the file and its buffers, which bounds what it may allocate.
     Importer(std::string path, tinygltf::Model& model, Scene& scene, const ImportOptions& options,
-             ImportStats& stats)
-        : path_(std::move(path)), model_(model), scene_(scene), options_(options), stats_(stats) {}
+             ImportStats& stats, uint64_t source_bytes)
+        : path_(std::move(path)), model_(model), scene_(scene), options_(options), stats_(stats),
+          source_bytes_(source_bytes),
+          zero_element_limit_(std::max(kMinZeroElementsPerFile,
+                                       mulBytes(source_bytes, kZeroElementsPerSourceByte))) {}
 
     Status run(const CapturedImages& captured);
 
@@ -338,6 +350,10 @@ private:
     bool quantization_ = false;
     const ImportOptions& options_;
     ImportStats& stats_;
+    uint64_t source_bytes_ = 0;
+    uint64_t zero_element_limit_ = 0;
+    uint64_t zero_elements_ = 0;    // elements read from accessors without a bufferView so far
+    uint64_t zero_value_bytes_ = 0; // and the bytes their values took
 };
 
 Status Importer::checkExtensions() {
@@ -814,6 +830,19 @@ Status Importer::accessorValues(int index, const std::string& what, const Attrib
     size_t total = 0;
     if (!mulSize(count, ncomp, total) || (acc.bufferView < 0 && count > kMaxZeroAccessorCount))
         return fail(name + " has an implausible count " + std::to_string(count));
+    if (acc.bufferView < 0) {
+        // Zeros cost nothing in the file: bound them by what the file holds, and the budget.
+        zero_elements_ += count;
+        zero_value_bytes_ = addBytes(zero_value_bytes_, mulBytes(total, sizeof(double)));
+        if (zero_elements_ > zero_element_limit_)
+            return fail(name + " (" + what + ") has no bufferView and brings the elements of " +
+                        "such accessors read by this file to " + std::to_string(zero_elements_) +
+                        ", more than the " + std::to_string(zero_element_limit_) + " a file of " +
+                        std::to_string(source_bytes_) + " bytes may declare");
+        FOCAL_GLTF_TRY(checkMemory(options_.memory_budget,
+                                   path_ + ": reading accessors without a bufferView",
+                                   zero_value_bytes_));
+    }
     out.clear();
 
     auto readElements = [&](const unsigned char* base, size_t stride, size_t n, int comp_type,
@@ -1422,47 +1451,124 @@ std::string tinygltfError(const std::string& err) {
     }
     if (startsWith(line, "File not found : "))
         return "buffer file not found: " + line.substr(std::strlen("File not found : "));
+    if (startsWith(line, "File read error : ")) {
+        // "File read error : PATH : WHY" (from readWholeFile)
+        const std::string rest = line.substr(std::strlen("File read error : "));
+        const size_t sep = rest.rfind(" : ");
+        return sep == std::string::npos
+                   ? "cannot read a buffer file: " + rest
+                   : "buffer file " + rest.substr(0, sep) + " " + rest.substr(sep + 3);
+    }
     return line;
 }
 
-Result<Scene> importImpl(const std::string& path, const ImportOptions& options,
-                         ImportStats& stats) {
-    const auto t0 = std::chrono::steady_clock::now();
-    // Read the whole file ourselves: precise "not found" messages, and GLB is recognised by its
-    // magic rather than its name.
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec))
-        return Status::error(path + ": file not found");
-    if (std::filesystem::is_directory(path, ec))
-        return Status::error(path + ": is a directory, not a glTF file");
-    std::ifstream file(path, std::ios::binary);
-    if (!file)
-        return Status::error(path + ": cannot be opened");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)),
-                                     std::istreambuf_iterator<char>());
-    if (file.bad())
-        return Status::error(path + ": read error");
-    if (bytes.empty())
-        return Status::error(path + ": file is empty");
-    if (bytes.size() > std::numeric_limits<unsigned int>::max())
-        return Status::error(path + ": file is larger than 4 GiB");
+// The deepest nesting of arrays and objects in JSON text (strings skipped), stopping as soon as
+// it exceeds `limit`; `at` is the byte offset where it did.
+size_t jsonDepth(const unsigned char* text, size_t size, size_t limit, size_t& at) {
+    size_t depth = 0, deepest = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < size; ++i) {
+        const unsigned char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i; // skip the escaped character
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            deepest = std::max(deepest, ++depth);
+            if (deepest > limit) {
+                at = i;
+                return deepest;
+            }
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return deepest;
+}
 
-    std::string base_dir = std::filesystem::path(path).parent_path().string();
-    if (base_dir.empty())
-        base_dir = ".";
+// The JSON text of a .gltf (all of it) or a .glb (its first chunk, when the header is sound;
+// tinygltf reports broken headers).
+std::pair<const unsigned char*, size_t> jsonText(const unsigned char* bytes, size_t size,
+                                                 bool glb) {
+    if (!glb)
+        return {bytes, size};
+    if (size < 20)
+        return {bytes, 0};
+    uint32_t chunk_length = 0;
+    std::memcpy(&chunk_length, bytes + 12, 4); // little-endian, as x86-64 and ARM64 are
+    return {bytes + 20, std::min<size_t>(chunk_length, size - 20)};
+}
+
+// Reads a file tinygltf asks for (buffers and images given by uri): only regular files, and
+// none larger than the memory budget. tinygltf's own reader takes a directory's size to be
+// huge and fails with std::bad_alloc ("out of memory" for a uri of "/").
+bool readWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                   void* user_data) {
+    const MemoryBudget& budget = *static_cast<const MemoryBudget*>(user_data);
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(st)) {
+        *err = "not found";
+        return false;
+    }
+    if (std::filesystem::is_directory(st)) {
+        *err = "is a directory, not a file";
+        return false;
+    }
+    if (!std::filesystem::is_regular_file(st)) {
+        *err = "is not a regular file";
+        return false;
+    }
+    const uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) {
+        *err = "cannot read its size";
+        return false;
+    }
+    if (Status s = checkMemory(budget, "reading it", size); !s.ok()) {
+        *err = s.message();
+        return false;
+    }
+    std::ifstream file(path, std::ios::binary);
+    out->resize(size);
+    if (!file || !file.read(reinterpret_cast<char*>(out->data()), std::streamsize(size))) {
+        *err = "read error";
+        return false;
+    }
+    return true;
+}
+
+Result<Scene> importBytes(const unsigned char* bytes, size_t size, const std::string& path,
+                          const std::string& base_dir, const ImportOptions& options,
+                          ImportStats& stats, std::chrono::steady_clock::time_point t0) {
+    if (size == 0)
+        return Status::error(path + ": file is empty");
+    if (size > std::numeric_limits<unsigned int>::max())
+        return Status::error(path + ": file is larger than 4 GiB");
+    const bool glb = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
+    // Bound the nesting before the recursive JSON parser sees it.
+    const auto [json, json_size] = jsonText(bytes, size, glb);
+    size_t deep_at = 0;
+    if (jsonDepth(json, json_size, kMaxJsonDepth, deep_at) > kMaxJsonDepth)
+        return Status::error(path + ": JSON nests deeper than " + std::to_string(kMaxJsonDepth) +
+                             " levels (at byte " + std::to_string(deep_at + size_t(json - bytes)) +
+                             "), the most focal accepts");
 
     tinygltf::TinyGLTF loader;
     CapturedImages captured;
     loader.SetImageLoader(&captureImage, &captured);
+    MemoryBudget budget = options.memory_budget;
+    loader.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &readWholeFile,
+                           &tinygltf::WriteWholeFile, &budget});
     tinygltf::Model model;
     std::string err, warn_text;
-    const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-    const unsigned int length = static_cast<unsigned int>(bytes.size());
+    const unsigned int length = static_cast<unsigned int>(size);
     const bool loaded =
-        glb ? loader.LoadBinaryFromMemory(&model, &err, &warn_text, bytes.data(), length, base_dir)
+        glb ? loader.LoadBinaryFromMemory(&model, &err, &warn_text, bytes, length, base_dir)
             : loader.LoadASCIIFromString(&model, &err, &warn_text,
-                                         reinterpret_cast<const char*>(bytes.data()), length,
-                                         base_dir);
+                                         reinterpret_cast<const char*>(bytes), length, base_dir);
     if (!loaded) {
         std::string message = tinygltfError(err);
         if (glb && !startsWith(message, "invalid JSON")) {
@@ -1482,11 +1588,46 @@ Result<Scene> importImpl(const std::string& path, const ImportOptions& options,
         scene.warnings.push_back("tinygltf: " + line);
     }
     stats.ms_parse = msSince(t0);
-    Importer importer(path, model, scene, options, stats);
+    uint64_t source_bytes = size;
+    for (const tinygltf::Buffer& b : model.buffers)
+        source_bytes = addBytes(source_bytes, b.data.size());
+    Importer importer(path, model, scene, options, stats, source_bytes);
     Status status = importer.run(captured);
     if (!status.ok())
         return status;
     return scene;
+}
+
+Result<Scene> importImpl(const std::string& path, const ImportOptions& options,
+                         ImportStats& stats) {
+    const auto t0 = std::chrono::steady_clock::now();
+    // Read the whole file ourselves: precise "not found" messages, and GLB is recognised by its
+    // magic rather than its name.
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(st))
+        return Status::error(path + ": file not found");
+    if (std::filesystem::is_directory(st))
+        return Status::error(path + ": is a directory, not a glTF file");
+    // /dev/zero or a pipe would be read forever.
+    if (!std::filesystem::is_regular_file(st))
+        return Status::error(path + ": is not a regular file");
+    const uintmax_t file_size = std::filesystem::file_size(path, ec);
+    if (!ec)
+        FOCAL_GLTF_TRY(
+            checkMemory(options.memory_budget, path + ": reading the file", uint64_t(file_size)));
+    std::ifstream file(path, std::ios::binary);
+    if (!file)
+        return Status::error(path + ": cannot be opened");
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)),
+                                     std::istreambuf_iterator<char>());
+    if (file.bad())
+        return Status::error(path + ": read error");
+
+    std::string base_dir = std::filesystem::path(path).parent_path().string();
+    if (base_dir.empty())
+        base_dir = ".";
+    return importBytes(bytes.data(), bytes.size(), path, base_dir, options, stats, t0);
 }
 
 // One line, no control characters, bounded length (tinygltf may quote a whole data URI).
@@ -1502,36 +1643,46 @@ Status oneLine(const Status& status) {
     return Status::error(std::move(message));
 }
 
-Result<Scene> importChecked(const std::string& path, const ImportOptions& options,
-                            ImportStats& stats) {
-    Result<Scene> result = importImpl(path, options, stats);
-    if (!result.ok())
-        return oneLine(result.status());
-    return result;
-}
-
-} // namespace
-
-Result<Scene> importGltf(const std::string& path, const ImportOptions& options,
-                         ImportStats* stats) {
+// Runs an import with its messages made one line, its total time measured, and anything
+// tinygltf throws turned into an error naming the file.
+template <class Import>
+Result<Scene> guardedImport(const std::string& path, ImportStats* stats, Import&& import) {
     const auto t0 = std::chrono::steady_clock::now();
     ImportStats local;
     ImportStats& out = stats ? *stats : local;
     out = ImportStats{};
     try {
-        Result<Scene> scene = importChecked(path, options, out);
+        Result<Scene> scene = import(out, t0);
         out.ms_total = msSince(t0);
+        if (!scene.ok())
+            return oneLine(scene.status());
         return scene;
     } catch (const std::bad_alloc&) {
         return Status::error(path + ": out of memory");
     } catch (const std::exception& e) {
         std::string what = firstLine(e.what());
         if (startsWith(what, "[json.exception."))
-            return Status::error(path + ": " + tinygltfError(what));
-        return Status::error(path + ": " + (what.empty() ? "import failed" : what));
+            return oneLine(Status::error(path + ": " + tinygltfError(what)));
+        return oneLine(Status::error(path + ": " + (what.empty() ? "import failed" : what)));
     } catch (...) {
         return Status::error(path + ": import failed");
     }
+}
+
+} // namespace
+
+Result<Scene> importGltf(const std::string& path, const ImportOptions& options,
+                         ImportStats* stats) {
+    return guardedImport(path, stats,
+                         [&](ImportStats& out, auto) { return importImpl(path, options, out); });
+}
+
+Result<Scene> importGltfFromMemory(const unsigned char* data, size_t size, const std::string& name,
+                                   const std::string& base_dir, const ImportOptions& options,
+                                   ImportStats* stats) {
+    return guardedImport(name, stats, [&](ImportStats& out, auto t0) {
+        return importBytes(data, size, name, base_dir, options, out, t0);
+    });
 }
 
 } // namespace raster

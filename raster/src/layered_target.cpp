@@ -1,4 +1,5 @@
 #include <raster/layered_target.h>
+#include <raster/memory_budget.h>
 
 #include <algorithm>
 #include <cmath>
@@ -28,6 +29,15 @@ uint32_t layerOf(const LayeredTargetDesc& desc, float d) {
     const auto it = std::upper_bound(desc.bounds.begin(), desc.bounds.end(), d);
     const int64_t l = int64_t(it - desc.bounds.begin()) - 1;
     return uint32_t(std::clamp<int64_t>(l, 0, int64_t(desc.bounds.size()) - 2));
+}
+
+uint64_t layeredTargetBytes(uint32_t width, uint32_t height, uint32_t layers,
+                            const LayeredTargetDesc& desc, bool transparency) {
+    const uint64_t texel = bytesPerColor(desc.color_format) + bytesPerDepth(desc.depth_format);
+    uint64_t per_texel = texel + (desc.gbuffer ? sizeof(GSample) : 0);
+    if (transparency)
+        per_texel += texel + (desc.gbuffer ? sizeof(GSample) + sizeof(float) : 0);
+    return mulBytes(mulBytes(uint64_t{width} * height, layers), per_texel);
 }
 
 } // namespace raster

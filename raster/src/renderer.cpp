@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <new>
 #include <string>
 #include <utility>
 
@@ -186,10 +187,27 @@ Status validate(const LayeredTargetDesc& desc) {
     return {};
 }
 
+std::string sizeText(const View& view) {
+    return std::to_string(view.width) + "x" + std::to_string(view.height);
+}
+
+// The one message for an allocation that failed although the budget admitted it.
+Status outOfMemory(const std::string& what) {
+    return Status::error("out of memory allocating " + what +
+                         " (lower --memory-budget to fail before allocating)");
+}
+
 } // namespace
 
 Status Renderer::render(const Scene& scene, const View& view, const RenderOptions& options,
-                        Frame& out, FrameStats* stats) {
+                        Frame& out, FrameStats* stats) try {
+    if (Status s = validate(view); !s.ok())
+        return s;
+    if (Status s = checkMemory(
+            options.memory_budget, "a " + sizeText(view) + " frame (colour and depth)",
+            frameBytes(view.width, view.height, options.depth_format, hasBlendMaterial(scene)));
+        !s.ok())
+        return s;
     if (Status s = prepare(scene, view, options, stats); !s.ok())
         return s;
     State& st = *state_;
@@ -222,12 +240,24 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
                     out.transparent_depth.bytes(),
                 stats);
     return {};
+} catch (const std::bad_alloc&) {
+    return outOfMemory("a " + sizeText(view) + " frame");
 }
 
 Status Renderer::renderLayers(const Scene& scene, const View& view, const RenderOptions& options,
                               const LayeredTargetDesc& desc, LayeredTarget& out,
-                              FrameStats* stats) {
+                              FrameStats* stats) try {
     if (Status s = validate(desc); !s.ok())
+        return s;
+    if (Status s = validate(view); !s.ok())
+        return s;
+    const uint32_t layer_count = uint32_t(desc.bounds.size() - 1);
+    if (Status s = checkMemory(options.memory_budget,
+                               "a " + sizeText(view) + " layered target with " +
+                                   std::to_string(layer_count) + " layers",
+                               layeredTargetBytes(view.width, view.height, layer_count, desc,
+                                                  hasBlendMaterial(scene)));
+        !s.ok())
         return s;
     if (Status s = prepare(scene, view, options, stats); !s.ok())
         return s;
@@ -297,15 +327,25 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     }
     finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
     return {};
+} catch (const std::bad_alloc&) {
+    return outOfMemory("a " + sizeText(view) + " layered target");
 }
 
 Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                                      const RenderOptions& options, const FragmentListDesc& desc,
-                                     FragmentLists& out, FrameStats* stats) {
+                                     FragmentLists& out, FrameStats* stats) try {
     if (desc.node_capacity == 0)
         return Status::error("fragment list node capacity must be at least 1");
     if (!(desc.hidden_epsilon >= 0.0f) || !std::isfinite(desc.hidden_epsilon))
         return Status::error("fragment list hidden epsilon must be finite and >= 0");
+    if (Status s = validate(view); !s.ok())
+        return s;
+    // Heads, offsets and list lengths per pixel, before any fragment is collected.
+    if (Status s = checkMemory(options.memory_budget,
+                               "the per-pixel list heads of a " + sizeText(view) + " image",
+                               mulBytes(uint64_t(view.width) * view.height, 12));
+        !s.ok())
+        return s;
     if (Status s = prepare(scene, view, options, stats); !s.ok())
         return s;
     State& st = *state_;
@@ -357,6 +397,14 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     for (const TileCounters& c : st.tile_counters)
         out.fragments_rejected += c.rejected;
     out.node_capacity_used = desc.node_capacity;
+    // The collected nodes, plus what the resolve stores per kept fragment (at most all of them).
+    const uint64_t per_fragment = sizeof(FragmentNode) + bytesPerColor(desc.color_format) +
+                                  bytesPerDepth(desc.depth_format) + sizeof(uint32_t);
+    if (Status s = checkMemory(options.memory_budget,
+                               std::to_string(collected) + " fragments in per-pixel lists",
+                               mulBytes(collected, per_fragment));
+        !s.ok())
+        return s;
     if (collected > desc.node_capacity) {
         if (desc.on_overflow == OverflowPolicy::Fail)
             return Status::error("fragment list overflow: " + std::to_string(collected) +
@@ -447,6 +495,8 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     });
     finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
     return {};
+} catch (const std::bad_alloc&) {
+    return outOfMemory("per-pixel fragment lists of a " + sizeText(view) + " image");
 }
 
 } // namespace raster

@@ -1,5 +1,7 @@
 #include <raster/task_pool.h>
 
+#include <utility>
+
 namespace raster {
 
 TaskPool::TaskPool(uint32_t threads) : thread_count_(threads) {
@@ -24,7 +26,16 @@ void TaskPool::drain(uint32_t worker) {
         const uint32_t index = next_.fetch_add(1, std::memory_order_relaxed);
         if (index >= job_count_)
             return;
-        (*job_)(index, worker);
+        try {
+            (*job_)(index, worker);
+        } catch (...) {
+            // Stop handing out work; the caller rethrows the first failure.
+            next_.store(job_count_, std::memory_order_relaxed);
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (!failure_)
+                failure_ = std::current_exception();
+            return;
+        }
     }
 }
 
@@ -68,6 +79,8 @@ void TaskPool::parallelFor(uint32_t count, const std::function<void(uint32_t, ui
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [&] { return busy_ == 0; });
     job_ = nullptr;
+    if (failure_)
+        std::rethrow_exception(std::exchange(failure_, nullptr));
 }
 
 } // namespace raster

@@ -147,6 +147,8 @@ TEST_F(Cli, RenderHelpListsEveryOptionWithItsDefault) {
         {"--depth-format", "=float32\\b"},
         {"--shading", "=material\\b"},
         {"--texture-filter", "=sampler\\b"},
+        {"--memory-budget", "=auto\\b"},
+        {"--dry-run", ""},
     };
     EXPECT_TRUE(contains(r.out, "scene")) << r.out;
     for (const auto& [option, pattern] : options) {
@@ -219,6 +221,10 @@ INSTANTIATE_TEST_SUITE_P(
                   renderArgs({"--method", "multilayer", "--level-filter", "disc"})},
         UsageCase{"aperture_grids_not_numbers",
                   renderArgs({"--method", "multilayer", "--aperture-grids", "four"})},
+        UsageCase{"memory_budget_unknown_unit", renderArgs({"--memory-budget", "8X"})},
+        UsageCase{"memory_budget_below_1mib", renderArgs({"--memory-budget", "100K"})},
+        UsageCase{"memory_budget_over_100_percent", renderArgs({"--memory-budget", "150%"})},
+        UsageCase{"memory_budget_not_a_number", renderArgs({"--memory-budget", "lots"})},
         UsageCase{"info_without_scene", {"info"}}),
     usageCaseName);
 
@@ -229,6 +235,33 @@ TEST_F(Cli, MissingSceneFileFailsWithOneLineNamingIt) {
     EXPECT_TRUE(failedWithOneErrorLine(r, 1));
     EXPECT_TRUE(contains(r.err, "missing.gltf")) << r.err;
     EXPECT_TRUE(files().empty()) << ::testing::PrintToString(files());
+}
+
+// Issue 23: the hostile fixtures crashed `focal info` as well as `focal render`.
+TEST_F(Cli, InfoRejectsHostileFilesWithOneLine) {
+    for (const char* name :
+         {"deep_nesting.gltf", "zero_accessors_per_file.gltf", "buffer_uri_directory.gltf"}) {
+        const std::string path = dataPath(std::string("gltf/bad/") + name);
+        const ProcessResult r = focal({"info", path});
+        EXPECT_TRUE(failedWithOneErrorLine(r, 1)) << name;
+        EXPECT_TRUE(contains(r.err, path)) << r.err;
+    }
+}
+
+TEST_F(Cli, DryRunChecksTheRequestAndWritesNothing) {
+    const ProcessResult ok = focal(renderArgs({"--method", "multiview", "--dry-run"}));
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_TRUE(contains(ok.out, "focal: dry run: --method multiview at 32x24 with 64 samples"))
+        << ok.out;
+    EXPECT_TRUE(files().empty()) << ::testing::PrintToString(files());
+    // The same request under a budget it exceeds fails the same way a real run does.
+    const ProcessResult over =
+        focal({"render", "builtin:demo", "-o", "out.png", "--method", "accum", "--dry-run",
+               "--memory-budget", "1M", "--width", "1024", "--height", "1024"});
+    EXPECT_TRUE(failedWithOneErrorLine(over, 1));
+    EXPECT_TRUE(contains(over.err, "--method accum at 1024x1024 with 64 samples needs 72 MiB, "
+                                   "more than the memory budget of 1.0 MiB (--memory-budget)"))
+        << over.err;
 }
 
 TEST_F(Cli, UnknownBuiltinSceneFailsWithOneLine) {

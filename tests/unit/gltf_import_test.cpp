@@ -15,6 +15,8 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -489,6 +491,13 @@ const BadCase kBadCases[] = {
     {"bad_alpha_mode.gltf", "material 0 has an unknown alphaMode \"SOMETIMES\""},
     {"bad_rotation.gltf", "node 0 rotation does not have 4 entries"},
     {"truncated.glb", "invalid GLB file"},
+    // Issue 23: hostile files.
+    {"deep_nesting.gltf", "JSON nests deeper than 128 levels (at byte 165), the most focal "
+                          "accepts"},
+    {"zero_accessors_per_file.gltf",
+     "accessor 2 (mesh 0 primitive 2 POSITION) has no bufferView and brings the elements of such "
+     "accessors read by this file to 1179648, more than the 1048576 a file of"},
+    {"buffer_uri_directory.gltf", "is a directory, not a file"},
 };
 
 std::string badCaseName(const ::testing::TestParamInfo<BadCase>& param) {
@@ -511,6 +520,73 @@ TEST(GltfImportBadFolder, EveryFixtureHasACase) {
                                         [&](const BadCase& c) { return name == c.file; });
         EXPECT_TRUE(listed) << name << " has no expected message in kBadCases";
     }
+}
+
+// Issue 23: hostile input beyond the fixtures (files too large to commit are written here).
+std::string writeTemp(const std::string& name, const std::string& text) {
+    const std::filesystem::path path = std::filesystem::temp_directory_path() / name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path.string();
+}
+
+// One triangle drawn from an accessor without a bufferView of `count` VEC3 elements.
+std::string zeroAccessorGltf(uint64_t count) {
+    return R"({"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"count":)" +
+           std::to_string(count) +
+           R"(,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],)"
+           R"("nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})";
+}
+
+TEST(GltfImportHostile, TinyFileCannotDeclareMillionsOfZeros) {
+    // 2^24 elements was the per-accessor limit: a 200-byte file made focal take 1.4 GB.
+    const std::string path = writeTemp("focal_zero_accessor_2p24.gltf", zeroAccessorGltf(1u << 24));
+    const auto r = importGltf(path);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find("has no bufferView and brings the elements of such "
+                                        "accessors read by this file to 16777216"),
+              std::string::npos)
+        << r.status().message();
+    std::filesystem::remove(path);
+}
+
+TEST(GltfImportHostile, ZerosAreCheckedAgainstTheMemoryBudget) {
+    // 2^20 - 2 elements (a multiple of 3) fit the per-file limit; 24 MiB of values do not fit 16.
+    const std::string path =
+        writeTemp("focal_zero_accessor_budget.gltf", zeroAccessorGltf((1u << 20) - 1));
+    raster::ImportOptions options;
+    options.memory_budget.bytes = uint64_t{16} << 20;
+    const auto r = importGltf(path, options);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find(
+                  "reading accessors without a bufferView needs 24 MiB, more than the memory "
+                  "budget of 16 MiB"),
+              std::string::npos)
+        << r.status().message();
+    EXPECT_TRUE(importGltf(path).ok()); // unlimited: zeros are a legal (if useless) mesh
+    std::filesystem::remove(path);
+}
+
+TEST(GltfImportHostile, RefusesWhatIsNotARegularFile) {
+    // /dev/zero would be read until memory runs out.
+    const auto r = importGltf("/dev/zero");
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.status().message(), "/dev/zero: is not a regular file");
+}
+
+TEST(GltfImportHostile, FromMemoryImportsLikeFromAFile) {
+    std::ifstream in(validPath("triangle.glb"), std::ios::binary);
+    const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                           std::istreambuf_iterator<char>());
+    const auto from_memory =
+        raster::importGltfFromMemory(bytes.data(), bytes.size(), "triangle.glb", ".");
+    ASSERT_TRUE(from_memory.ok()) << from_memory.status().message();
+    const Scene from_file = load("triangle.glb");
+    ASSERT_EQ(from_memory->meshes.size(), from_file.meshes.size());
+    EXPECT_EQ(from_memory->meshes[0].primitives[0].positions,
+              from_file.meshes[0].primitives[0].positions);
+    const auto nested = raster::importGltfFromMemory(
+        reinterpret_cast<const unsigned char*>("[[[[]]]]"), 8, "x.gltf", ".");
+    EXPECT_FALSE(nested.ok());
 }
 
 // Third-party scenes (not shipped with focal; see /work/shared/scenes/README.md).

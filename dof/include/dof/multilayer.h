@@ -14,6 +14,7 @@
 #include <dof/lens_samples.h>
 #include <raster/camera.h>
 #include <raster/fragment_lists.h>
+#include <raster/memory_budget.h>
 #include <raster/status.h>
 #include <raster/storage.h>
 #include <raster/task_pool.h>
@@ -81,6 +82,10 @@ struct MultilayerSettings {
     uint32_t node_capacity = 1u << 22; // initial fragment node pool (it grows on overflow)
     // Also write each level's contribution to the image (Fig. 7) into MultilayerImage.
     bool level_contributions = false;
+    // Checked once the filter levels are planned (§5.2's stack levels grow the image by their
+    // dilation, so a CoC of thousands of pixels plans levels far larger than the image): their
+    // cells times fragments_per_pixel fragments must fit, or filter() fails naming the sizes.
+    raster::MemoryBudget memory_budget;
 };
 
 // Rejects bad settings with a message naming the command-line option.

@@ -267,4 +267,13 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
 // Validates settings alone (ranges of every option, messages naming them).
 raster::Status validate(const MultiviewSettings& settings, uint32_t sample_count);
 
+// A lower bound of the bytes renderMultiview holds for a width x height image with
+// `sample_count` lens samples on `workers` workers, from the settings alone (layers = 0 counts
+// one layer): the pinhole frame, the output, the layered target with its per-layer depth copy,
+// and each worker's ray states for one tile. Checked against the memory budget before anything
+// is rendered, so an absurd request fails in milliseconds; the layered target's real size is
+// checked again by Renderer::renderLayers once the layer count is known.
+uint64_t multiviewMinimumBytes(const MultiviewSettings& settings, uint32_t width, uint32_t height,
+                               uint32_t sample_count, uint32_t workers);
+
 } // namespace dof

@@ -2,6 +2,7 @@
 // Owned by the caller, resized by the renderer; rows are stored top row first.
 #pragma once
 
+#include <raster/memory_budget.h>
 #include <raster/storage.h>
 
 #include <cstdint>
@@ -19,6 +20,15 @@ struct Frame {
     // visible depths reads both. Sized only when the scene has BLEND materials.
     DepthBuffer transparent_depth;
 };
+
+// Bytes of the buffers a width x height Frame holds (colour, depth, and with BLEND materials the
+// transparent depth): what Renderer::render checks against the memory budget.
+inline uint64_t frameBytes(uint32_t width, uint32_t height, DepthFormat depth_format,
+                           bool transparency) {
+    const uint64_t per_pixel =
+        4 * sizeof(float) + uint64_t{bytesPerDepth(depth_format)} * (transparency ? 2 : 1);
+    return mulBytes(uint64_t{width} * height, per_pixel);
+}
 
 // Calls fn(stored D) for every visible surface depth of the frame: the opaque depth and the
 // nearest BLEND surface of each covered pixel (D < 1), in pixel order.

@@ -4,10 +4,12 @@
 // parallel on the caller's TaskPool; the Scene is identical for any thread count.
 #pragma once
 
+#include <raster/memory_budget.h>
 #include <raster/scene.h>
 #include <raster/status.h>
 #include <raster/task_pool.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -23,6 +25,9 @@ struct ImportOptions {
     std::optional<TextureRoles> roles;
     // Decodes images in parallel when set (one image per task); nullptr decodes inline.
     TaskPool* pool = nullptr;
+    // Bounds the file, its buffer and image files, and the zeros of accessors without a
+    // bufferView (which cost nothing in the file); unlimited by default.
+    MemoryBudget memory_budget;
 };
 
 // Where import time went. Times are wall-clock milliseconds and not deterministic, except that
@@ -46,5 +51,11 @@ struct ImportStats {
 // it (a missing file, no bytes, an absurd size in its header) are reported, as warnings.
 Result<Scene> importGltf(const std::string& path, const ImportOptions& options = {},
                          ImportStats* stats = nullptr);
+
+// The same for a .gltf or .glb already in memory (the fuzzer, embedded use). `name` stands for
+// the file in messages; relative uris of buffers and images resolve against `base_dir`.
+Result<Scene> importGltfFromMemory(const unsigned char* data, size_t size, const std::string& name,
+                                   const std::string& base_dir, const ImportOptions& options = {},
+                                   ImportStats* stats = nullptr);
 
 } // namespace raster

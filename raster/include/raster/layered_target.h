@@ -83,6 +83,11 @@ struct LayeredTarget {
     }
 };
 
+// Bytes of the buffers a width x height LayeredTarget with `layers` layers holds (with BLEND
+// materials, also the transparent planes): what Renderer::renderLayers checks against the budget.
+uint64_t layeredTargetBytes(uint32_t width, uint32_t height, uint32_t layers,
+                            const LayeredTargetDesc& desc, bool transparency);
+
 // The overlapped interval of layer l in distances [near, far).
 struct LayerInterval {
     float near_d;

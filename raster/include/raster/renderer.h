@@ -8,6 +8,7 @@
 #include <raster/fragment_lists.h>
 #include <raster/frame.h>
 #include <raster/layered_target.h>
+#include <raster/memory_budget.h>
 #include <raster/scene.h>
 #include <raster/status.h>
 #include <raster/task_pool.h>
@@ -40,6 +41,10 @@ struct RenderOptions {
     // depth is not strictly behind this buffer's value (same size and format as the frame's) are
     // discarded, so repeated renders peel the scene front to back.
     const DepthBuffer* peel_depth = nullptr;
+    // Checked before the target's buffers are allocated (frameBytes, layeredTargetBytes, the
+    // fragment pool: frame.h, layered_target.h); a render that does not fit fails with a Status
+    // naming the sizes.
+    MemoryBudget memory_budget;
 };
 
 // Counts and stage times of one render. Counts are deterministic; times are not.
@@ -65,8 +70,9 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     // Renders `scene` seen through `view` into `out` (resized to view.width x view.height).
-    // Fails only on invalid options or views, or when a material's texture in a role the
-    // shading samples has no pixels (an image import skipped); never on other scene content.
+    // Fails only on invalid options or views, when a material's texture in a role the shading
+    // samples has no pixels (an image import skipped), or when the target exceeds
+    // options.memory_budget or cannot be allocated; never on other scene content.
     Status render(const Scene& scene, const View& view, const RenderOptions& options, Frame& out,
                   FrameStats* stats = nullptr);
 

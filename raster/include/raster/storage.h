@@ -17,6 +17,14 @@ enum class DepthFormat : uint8_t { Unorm16, Float32 };
 // RGBA colour storage.
 enum class ColorFormat : uint8_t { Half, Float32 };
 
+// Bytes one stored value takes: a depth, or an RGBA colour.
+constexpr uint32_t bytesPerDepth(DepthFormat f) {
+    return f == DepthFormat::Unorm16 ? 2 : 4;
+}
+constexpr uint32_t bytesPerColor(ColorFormat f) {
+    return f == ColorFormat::Half ? 8 : 16;
+}
+
 // Round-to-nearest unorm16 encoding of D in [0,1].
 inline uint16_t encodeUnorm16(float d) {
     const float clamped = d < 0.0f ? 0.0f : (d > 1.0f ? 1.0f : d);

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -26,7 +27,9 @@ public:
     uint32_t threadCount() const { return thread_count_; }
 
     // Calls fn(index, worker) once for every index in [0, count); returns when all are done.
-    // The calling thread takes part as worker 0. Not reentrant.
+    // The calling thread takes part as worker 0. Not reentrant. If fn throws (std::bad_alloc
+    // in practice), the remaining indices are skipped and the first exception is rethrown here
+    // on the calling thread, instead of ending the process in std::terminate on a worker.
     void parallelFor(uint32_t count, const std::function<void(uint32_t, uint32_t)>& fn);
 
 private:
@@ -45,6 +48,7 @@ private:
     uint32_t busy_ = 0;
     bool stop_ = false;
     std::atomic<uint32_t> next_{0};
+    std::exception_ptr failure_; // the first exception fn threw (guarded by mutex_)
 };
 
 } // namespace raster

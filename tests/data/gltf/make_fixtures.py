@@ -3,7 +3,9 @@
 
 Run from anywhere: python3 tests/data/gltf/make_fixtures.py
 valid/   files that must import, with the values the tests check;
-bad/     one malformed file per error case (the expected message is in the test's table).
+bad/     one malformed file per error case (the expected message is in the test's table);
+../../fuzz/corpus/gltf_import/   seeds for the importer's fuzzer that reach KHR_mesh_quantization,
+         matrix accessors and the non-finite checks (tests/fuzz, docs/testing.md).
 """
 import base64
 import copy
@@ -18,6 +20,8 @@ VALID = os.path.join(HERE, "valid")
 BAD = os.path.join(HERE, "bad")
 
 FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
+BYTE, SHORT = 5120, 5122
+FUZZ_SEEDS = os.path.join(HERE, "..", "..", "fuzz", "corpus", "gltf_import")
 
 
 # --- tiny PNG writer -------------------------------------------------------------------------
@@ -74,9 +78,10 @@ class Gltf:
         return len(self.doc["bufferViews"]) - 1
 
     def accessor(self, values, ctype, atype, normalized=False, minmax=False):
-        ncomp = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}[atype]
+        ncomp = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9,
+                 "MAT4": 16}[atype]
         flat = [c for v in values for c in (v if isinstance(v, (list, tuple)) else [v])]
-        code = {FLOAT: "f", UBYTE: "B", USHORT: "H", UINT: "I"}[ctype]
+        code = {FLOAT: "f", UBYTE: "B", USHORT: "H", UINT: "I", BYTE: "b", SHORT: "h"}[ctype]
         data = struct.pack("<%d%s" % (len(flat), code), *flat)
         a = {"bufferView": self.view(data), "componentType": ctype,
              "count": len(flat) // ncomp, "type": atype}
@@ -513,6 +518,25 @@ def make_bad():
     d["nodes"][0]["rotation"] = [0, 0, 0]
     save("bad_rotation.gltf", d)
 
+    # Issue 23: hostile files. asset.extras nested 15,000 deep (30 KB; the recursive JSON
+    # parser ran out of stack).
+    with open(os.path.join(BAD, "deep_nesting.gltf"), "w") as f:
+        f.write('{"asset": {"version": "2.0", "extras": ' + "[" * 15000 + "]" * 15000 + "}}\n")
+
+    # 16 primitives reading accessors without a bufferView (zeros, which cost nothing in the
+    # file): each is allowed, their sum is not (a 1.2 KB file asked for ~14 GB).
+    d = tri().finish()
+    n = 3 * 2 ** 17
+    d["accessors"].append({"componentType": FLOAT, "count": n, "type": "VEC3"})
+    zeros = len(d["accessors"]) - 1
+    d["meshes"][0]["primitives"] = [{"attributes": {"POSITION": zeros}}] * 16
+    save("zero_accessors_per_file.gltf", d)
+
+    # A buffer uri naming a directory (was reported as "out of memory").
+    d = tri().finish()
+    d["buffers"][0]["uri"] = "."
+    save("buffer_uri_directory.gltf", d)
+
     # A GLB cut short in the middle of its JSON chunk.
     g = triangle_doc()
     full = os.path.join(BAD, "truncated.glb")
@@ -523,6 +547,90 @@ def make_bad():
         f.write(data[:60])
 
 
+def make_fuzz_seeds():
+    os.makedirs(FUZZ_SEEDS, exist_ok=True)
+
+    def save(name, doc):
+        # Python writes infinity as Infinity, which is not JSON; 1e999 is, and parses as it.
+        text = json.dumps(doc, indent=1).replace("-Infinity", "-1e999")
+        with open(os.path.join(FUZZ_SEEDS, name), "w") as f:
+            f.write(text.replace("Infinity", "1e999") + "\n")
+
+    # KHR_mesh_quantization: normalized SHORT positions, BYTE normals, UBYTE texcoords, BYTE
+    # (unnormalized) positions of a second primitive, dequantized by the node's scale.
+    g = Gltf()
+    qpos = g.accessor([(0, 0, 0), (32767, 0, 0), (0, 32767, 0)], SHORT, "VEC3", normalized=True,
+                      minmax=True)
+    qnrm = g.accessor([(0, 0, 127)] * 3, BYTE, "VEC3", normalized=True)
+    quv = g.accessor([(0, 0), (255, 0), (0, 255)], UBYTE, "VEC2", normalized=True)
+    bpos = g.accessor([(0, 0, -1), (100, 0, -1), (0, 100, -1)], BYTE, "VEC3", minmax=True)
+    idx = g.accessor([0, 1, 2], USHORT, "SCALAR")
+    g.doc["extensionsUsed"] = ["KHR_mesh_quantization"]
+    g.doc["extensionsRequired"] = ["KHR_mesh_quantization"]
+    g.doc["meshes"] = [{"primitives": [
+        {"attributes": {"POSITION": qpos, "NORMAL": qnrm, "TEXCOORD_0": quv}, "indices": idx},
+        {"attributes": {"POSITION": bpos}}]}]
+    g.doc["nodes"] = [{"mesh": 0, "scale": [0.01, 0.01, 0.01]}]
+    g.doc["scenes"] = [{"nodes": [0]}]
+    save("quantized.gltf", g.finish())
+    doc = g.finish(uri="")
+    write_glb(FUZZ_SEEDS, "quantized.glb", doc, g.bin)
+
+    # Matrix accessors (MAT2/MAT3/MAT4, normalized 1-byte columns are padded) used as
+    # attributes and as a skin's inverse bind matrices, and node matrices.
+    g = triangle_doc()
+    m4 = g.accessor([[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]] * 3, FLOAT, "MAT4")
+    m2 = g.accessor([[1, 0, 0, 1]] * 3, UBYTE, "MAT2", normalized=True)
+    g.doc["meshes"].append({"primitives": [{"attributes": {"POSITION": m4, "NORMAL": m2}}]})
+    g.doc["skins"] = [{"joints": [0], "inverseBindMatrices": m4}]
+    g.doc["nodes"][0]["matrix"] = [2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 1, 2, 3, 1]
+    g.doc["nodes"].append({"mesh": 1, "skin": 0})
+    g.doc["scenes"] = [{"nodes": [0, 1]}]
+    save("matrix_accessors.gltf", g.finish())
+
+    # Non-finite numbers. JSON has none, and the parser refuses 1e999 (non_finite_json.gltf),
+    # so they come from finite numbers that overflow: a node scale of 3e38 under which a mesh,
+    # a camera and a light sit (world matrices of inf), 3e38 factors; and NaN in vertex data.
+    g = triangle_doc()
+    d = g.finish()
+    d["nodes"] = [{"scale": [3e38, 3e38, 3e38], "children": [1, 2, 3]},
+                  {"mesh": 0, "translation": [3e38, 0, 0]},
+                  {"camera": 0, "translation": [0, 0, 3e38]},
+                  {"extensions": {"KHR_lights_punctual": {"light": 0}}}]
+    d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 3.14159, "znear": 1e-38}}]
+    d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 3e38,
+                                                           "color": [3e38, 3e38, 3e38]}]}}
+    d["materials"] = [{"pbrMetallicRoughness": {"baseColorFactor": [3e38, 3e38, 0, 1]},
+                       "emissiveFactor": [3e38, 0, 0]}]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    d["scenes"] = [{"nodes": [0]}]
+    save("non_finite.gltf", d)
+    g = triangle_doc()
+    d = g.finish()
+    d["materials"] = [{"pbrMetallicRoughness": {"baseColorFactor": [1e999, 0, 0, 1],
+                                                "metallicFactor": -1e999},
+                       "emissiveFactor": [0, 1e999, 0], "alphaCutoff": 1e999}]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    d["nodes"][0]["translation"] = [1e999, 0, 0]
+    d["nodes"].append({"camera": 0, "rotation": [0, 0, 0, 1e999]})
+    d["cameras"] = [{"type": "perspective",
+                     "perspective": {"yfov": 1e999, "znear": 0.1, "zfar": 1e999}}]
+    d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "spot", "intensity": 1e999,
+                                                           "spot": {"outerConeAngle": 1e999}}]}}
+    d["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}})
+    d["scenes"] = [{"nodes": [0, 1, 2]}]
+    save("non_finite_json.gltf", d)
+    g = Gltf()
+    pos = g.accessor([(0, 0, 0), (math.nan, 0, 0), (0, math.inf, 0)], FLOAT, "VEC3")
+    g.doc["meshes"] = [{"primitives": [{"attributes": {"POSITION": pos}}]}]
+    g.doc["nodes"] = [{"mesh": 0}]
+    g.doc["scenes"] = [{"nodes": [0]}]
+    save("non_finite_positions.gltf", g.finish())
+
+
 if __name__ == "__main__":
     make_valid()
     make_bad()
+    make_fuzz_seeds()

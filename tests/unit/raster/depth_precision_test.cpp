@@ -1,0 +1,74 @@
+// raster/depth_precision.h: the numbers behind the "no silent wrong image" warnings (issue 23).
+#include <raster/camera.h>
+#include <raster/depth_precision.h>
+#include <raster/storage.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace {
+
+using raster::DepthFormat;
+
+raster::View viewWithNear(float znear, float zfar = 0.0f) {
+    raster::View v;
+    v.znear = znear;
+    v.zfar = zfar;
+    return v;
+}
+
+TEST(DepthPrecision, FarthestStorableDistanceIsWhereTheFarValueTakesOver) {
+    const raster::View v = viewWithNear(1e-5f);
+    const float unorm = raster::farthestStorableDistance(v, DepthFormat::Unorm16);
+    EXPECT_NEAR(unorm, 1e-5f * 131070.0f, 1e-4f); // 1.31
+    // Just inside it still stores below 65535, just beyond it stores the far value.
+    EXPECT_LT(raster::encodeUnorm16(raster::depthFromDistance(v, 0.99f * unorm)), 65535);
+    EXPECT_EQ(raster::encodeUnorm16(raster::depthFromDistance(v, 1.01f * unorm)), 65535);
+    const float f32 = raster::farthestStorableDistance(v, DepthFormat::Float32);
+    EXPECT_LT(raster::depthFromDistance(v, 0.9f * f32), 1.0f);
+    EXPECT_EQ(raster::depthFromDistance(v, 1.1f * f32), 1.0f);
+    // With a finite far plane, only the last half step before it is lost (0.76% of 100 here).
+    EXPECT_NEAR(raster::farthestStorableDistance(viewWithNear(0.1f, 100.0f), DepthFormat::Unorm16),
+                99.24f, 0.01f);
+}
+
+TEST(DepthPrecision, ResolutionGrowsWithTheSquareOfDistance) {
+    const raster::View v = viewWithNear(0.1f);
+    const float at10 = raster::depthResolution(v, DepthFormat::Unorm16, 10.0f);
+    EXPECT_NEAR(at10, 10.0f * 10.0f / (0.1f * 65535.0f), 1e-5f);
+    EXPECT_NEAR(raster::depthResolution(v, DepthFormat::Unorm16, 20.0f), 4.0f * at10, 1e-4f);
+    // float stores D near 1 with 2^-24 steps: 256 times finer than unorm16 there.
+    EXPECT_NEAR(raster::depthResolution(v, DepthFormat::Float32, 10.0f) * 256.0f, at10,
+                0.01f * at10);
+}
+
+TEST(DepthPrecision, ProblemNamesTheNumbers) {
+    // The issue's case: --near 1e-5 --depth-format unorm16 drew an empty sky without a word.
+    const auto problem = raster::depthPrecisionProblem(viewWithNear(1e-5f), DepthFormat::Unorm16,
+                                                       2.0f, 25.0f, "depth");
+    ASSERT_TRUE(problem.has_value());
+    EXPECT_EQ(*problem, "unorm16 depth with near 1e-05 stores every distance beyond 1.31 as the "
+                        "far plane, but the scene reaches 25: surfaces beyond 1.31 are not drawn "
+                        "(raise --near or use float32 depth)");
+    // Float depth (D = 1 - n/d, not reversed) keeps them, but only 3.7 units apart at 25.
+    const auto f32 = raster::depthPrecisionProblem(viewWithNear(1e-5f), DepthFormat::Float32, 2.0f,
+                                                   25.0f, "depth");
+    ASSERT_TRUE(f32.has_value());
+    EXPECT_NE(f32->find("float32 depth with near 1e-05 resolves distances near 25 only to 3.7"),
+              std::string::npos)
+        << *f32;
+    // The usual near planes are fine with either format.
+    EXPECT_FALSE(raster::depthPrecisionProblem(viewWithNear(1e-3f), DepthFormat::Float32, 2.0f,
+                                               25.0f, "depth"));
+    EXPECT_FALSE(raster::depthPrecisionProblem(viewWithNear(0.05f), DepthFormat::Unorm16, 2.0f,
+                                               25.0f, "depth"));
+    // Coarse but not lost: near 0.001, unorm16 at 1000 steps 15 units.
+    const auto coarse = raster::depthPrecisionProblem(viewWithNear(1e-3f), DepthFormat::Unorm16,
+                                                      1.0f, 100.0f, "layer depth");
+    ASSERT_TRUE(coarse.has_value());
+    EXPECT_NE(coarse->find("resolves distances near 100 only to 153"), std::string::npos)
+        << *coarse;
+}
+
+} // namespace
