@@ -21,6 +21,18 @@ struct AxisTap {
     float f = 0.0f;
 };
 
+// The cells [lo, hi] that taps with a weight > 0 read along one axis.
+void readRange(const std::vector<AxisTap>& taps, uint32_t& lo, uint32_t& hi) {
+    lo = std::numeric_limits<uint32_t>::max();
+    hi = 0;
+    for (const AxisTap& t : taps) {
+        if (1.0f - t.f > 0.0f)
+            lo = std::min(lo, t.i0), hi = std::max(hi, t.i0);
+        if (t.f > 0.0f)
+            lo = std::min(lo, t.i1), hi = std::max(hi, t.i1);
+    }
+}
+
 std::vector<AxisTap> axisTaps(uint32_t pixels, float origin, float spacing, uint32_t cells) {
     std::vector<AxisTap> taps(pixels);
     const int64_t last = int64_t(cells) - 1;
@@ -150,6 +162,7 @@ MultilayerLevelStats levelStats(const FragmentLevel& l) {
     ls.max_list_length = l.max_list_length;
     ls.mean_list_length = double(l.fragments) / (double(l.width) * double(l.height));
     ls.truncated = l.truncated;
+    ls.cells_skipped = l.skipped;
     return ls;
 }
 
@@ -281,31 +294,21 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             asymmetric = asymmetric || !sameWeights(grids[0][g], grids[1][g]);
     }
 
-    // §5: plan the Y-map and T, compute the border table (§6.1), filter level by level.
+    // §5: plan the Y-map and T, compute the border table (§6.1).
     Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
     borders_ = levelBorders(lens, plan.variance, m2);
-    // Box levels up to the highest one T reads (all of them with box levels).
+    // Box levels up to the highest one T reads (all of them with box levels), then the
+    // aperture levels, far side then (asymmetric aperture) near side.
     uint32_t boxes_needed = uint32_t(plan.boxes.size());
     if (shaped)
         boxes_needed = plan.apertures.empty() ? 1u : plan.apertures.back().source + 1u;
     levels_.resize(boxes_needed);
-    for (uint32_t s = 1; s < boxes_needed; ++s) {
-        FragmentLevel& l = levels_[s];
-        adoptGeometry(plan.boxes[s], l);
-        filterLevel(levels_[s - 1], plan.plan, borders_, firstReader(plan, s), pool, l);
-    }
-    // Aperture levels, far side then (asymmetric aperture) near side.
+    for (uint32_t s = 1; s < boxes_needed; ++s)
+        adoptGeometry(plan.boxes[s], levels_[s]);
     const size_t shaped_count = plan.apertures.size();
     apertures_.resize(asymmetric ? 2 * shaped_count : shaped_count);
-    for (size_t side = 0; side < (asymmetric ? 2u : 1u); ++side)
-        for (size_t a = 0; a < shaped_count; ++a) {
-            FragmentLevel& l = apertures_[side * shaped_count + a];
-            adoptGeometry(plan.apertures[a], l);
-            const auto grid = std::find_if(grids[side].begin(), grids[side].end(),
-                                           [&](const ApertureGrid& g) { return g.size == l.grid; });
-            shapeLevel(levels_[l.source], *grid, plan.plan, borders_, pool, l);
-        }
-    const double ms_filter = msSince(t0);
+    for (size_t a = 0; a < apertures_.size(); ++a)
+        adoptGeometry(plan.apertures[a % shaped_count], apertures_[a]);
 
     // The levels of T on each side of the focal plane ([near, far]).
     const uint32_t n = uint32_t(plan.traversal.size()) - 1;
@@ -329,15 +332,50 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         }
     }
     const uint32_t sides = asymmetric ? 2 : 1;
-
-    // §6.1: traverse T near to far per pixel, blend the slices met front to back.
-    t0 = std::chrono::steady_clock::now();
+    const auto sideOf = [&](const LevelBorders::Segment& seg) {
+        return sides == 2 && seg.begin >= lens.focus_distance ? 1u : 0u;
+    };
+    // The bilinear taps of every level of T at the pixel centres (§6.1).
     std::vector<std::vector<AxisTap>> tx(n + 1), ty(n + 1);
     for (uint32_t s = 0; s <= n; ++s) {
         const FragmentLevel& l = *tlevel[1][s];
         tx[s] = axisTaps(width, l.origin_x, l.spacing, l.width);
         ty[s] = axisTaps(height, l.origin_y, l.spacing, l.height);
     }
+    // What the traversal reads of a level: the cells its taps reach and the segments of T
+    // that read it, merged where they touch.
+    const auto readsOf = [&](const FragmentLevel& level) {
+        LevelReads r;
+        readRange(tx[level.index], r.x0, r.x1);
+        readRange(ty[level.index], r.y0, r.y1);
+        for (const LevelBorders::Segment& seg : segments) {
+            const uint32_t side = sideOf(seg);
+            if (tlevel[side][seg.lo] != &level && tlevel[side][seg.hi] != &level)
+                continue;
+            if (!r.depths.empty() && r.depths.back().end == seg.begin)
+                r.depths.back().end = seg.end;
+            else
+                r.depths.push_back({seg.begin, seg.end});
+        }
+        return r;
+    };
+
+    // §5: filter level by level.
+    for (uint32_t s = 1; s < boxes_needed; ++s)
+        filterLevel(levels_[s - 1], plan.plan, borders_, firstReader(plan, s), pool, levels_[s]);
+    for (size_t a = 0; a < apertures_.size(); ++a) {
+        FragmentLevel& l = apertures_[a];
+        const size_t side = a / shaped_count; // 0: far, 1: near
+        const auto grid = std::find_if(grids[side].begin(), grids[side].end(),
+                                       [&](const ApertureGrid& g) { return g.size == l.grid; });
+        const LevelReads reads = readsOf(l);
+        shapeLevel(levels_[l.source], *grid, plan.plan, borders_,
+                   settings.skip_unread_cells ? &reads : nullptr, pool, l);
+    }
+    const double ms_filter = msSince(t0);
+
+    // §6.1: traverse T near to far per pixel, blend the slices met front to back.
+    t0 = std::chrono::steady_clock::now();
     out.width = width;
     out.height = height;
     out.rgba.assign(size_t(width) * height * 4, 0.0f);
@@ -389,7 +427,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             for (const LevelBorders::Segment& seg : segments) {
                 if (ca >= kOpaque)
                     break;
-                const uint32_t side = sides == 2 && seg.begin >= lens.focus_distance ? 1 : 0;
+                const uint32_t side = sideOf(seg);
                 Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
                 const uint32_t* count_side = cursor_count[side];
                 const uint32_t lv[2] = {seg.lo, seg.hi};
