@@ -56,6 +56,32 @@ struct Cursor {
     bool pieces = false; // a filtered level's cell (shareInList)
 };
 
+// The rows of cells a level's bilinear taps read on one row of pixels: cell row j0 with weight
+// 1 - f, then j1 with weight f, each kept only with a weight > 0 and fragments in it.
+struct TapRows {
+    uint32_t count = 0;
+    const uint32_t* starts[2] = {}; // the row's list starts (FragmentLevel::starts)
+    const LayerFragment* data[2] = {};
+    float weight[2] = {};
+    bool pieces = false; // a filtered level (shareInList)
+};
+
+TapRows tapRows(const FragmentLevel& level, const AxisTap& ay) {
+    TapRows t;
+    t.pieces = level.kind != LevelKind::Base;
+    const uint32_t cy[2] = {ay.i0, ay.i1};
+    const float wy[2] = {1.0f - ay.f, ay.f};
+    for (int r = 0; r < 2; ++r) {
+        if (!(wy[r] > 0.0f) || level.rows[cy[r]].empty())
+            continue;
+        t.starts[t.count] = level.starts.data() + size_t(cy[r]) * (level.width + 1);
+        t.data[t.count] = level.rows[cy[r]].data();
+        t.weight[t.count] = wy[r];
+        ++t.count;
+    }
+    return t;
+}
+
 constexpr float kOpaque = 1.0f - 1.0f / 1024.0f; // stop once the pixel is this opaque
 
 // The frame's plan: the box hierarchy (§5), the aperture levels read from it, and T, the
@@ -390,36 +416,43 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         settings.blend == LayerBlend::Additive ? 1.0f + settings.additive_gap : 0.0f;
     std::vector<uint64_t> row_slices(height, 0);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
+        // The rows of cells every level's bilinear taps read on this row of pixels: those with
+        // a weight > 0 that hold fragments (the others add w·0 to no slice).
+        TapRows rows[2][kMaxTraversalLevels];
+        for (uint32_t side = 0; side < sides; ++side)
+            for (uint32_t s = 0; s <= n; ++s)
+                rows[side][s] = tapRows(*tlevel[side][s], ty[s][y]);
         Cursor cursors[2][kMaxTraversalLevels][4];
         uint32_t cursor_count[2][kMaxTraversalLevels];
         uint64_t slices = 0; // stored once: neighbouring rows' counts share cache lines
         for (uint32_t x = 0; x < width; ++x) {
             const size_t p = size_t(y) * width + x;
-            // Bilinear taps of every level at the pixel centre (zero weights skipped).
+            // Bilinear taps of every level at the pixel centre, in the order (i0, j0), (i1, j0),
+            // (i0, j1), (i1, j1); taps with weight 0 or an empty list are left out, since they
+            // add w·0 to every slice.
             for (uint32_t side = 0; side < sides; ++side)
                 for (uint32_t s = 0; s <= n; ++s) {
+                    const TapRows& tr = rows[side][s];
                     const AxisTap ax = tx[s][x];
-                    const AxisTap ay = ty[s][y];
-                    const uint32_t cx[4] = {ax.i0, ax.i1, ax.i0, ax.i1};
-                    const uint32_t cy[4] = {ay.i0, ay.i0, ay.i1, ay.i1};
-                    const float w[4] = {(1.0f - ax.f) * (1.0f - ay.f), ax.f * (1.0f - ay.f),
-                                        (1.0f - ax.f) * ay.f, ax.f * ay.f};
+                    const uint32_t cx[2] = {ax.i0, ax.i1};
+                    const float wx[2] = {1.0f - ax.f, ax.f};
                     uint32_t c = 0;
-                    for (int k = 0; k < 4; ++k) {
-                        if (!(w[k] > 0.0f))
-                            continue;
-                        Cursor& cur = cursors[side][s][c++];
-                        cur.data = tlevel[side][s]->list(cx[k], cy[k], cur.count);
-                        cur.next = 0;
-                        cur.weight = w[k];
-                        cur.pieces = tlevel[side][s]->kind != LevelKind::Base;
-                    }
+                    for (uint32_t r = 0; r < tr.count; ++r)
+                        for (int k = 0; k < 2; ++k) {
+                            const float w = wx[k] * tr.weight[r];
+                            const uint32_t first = tr.starts[r][cx[k]];
+                            const uint32_t count = tr.starts[r][cx[k] + 1] - first;
+                            if (!(w > 0.0f) || count == 0)
+                                continue;
+                            cursors[side][s][c++] = {tr.data[r] + first, count, 0, w, tr.pieces};
+                        }
                     cursor_count[side][s] = c;
                 }
             {
-                const Cursor& b = cursors[0][0][0];
-                if (b.count > 0)
-                    out.depth[p] = b.data[0].depth;
+                uint32_t count = 0;
+                const LayerFragment* base = levels_[0].list(x, y, count);
+                if (count > 0)
+                    out.depth[p] = base[0].depth;
             }
             float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
             float ca_g = 0.0f, ga = 0.0f, last_d = 0.0f;
@@ -432,6 +465,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                 const uint32_t* count_side = cursor_count[side];
                 const uint32_t lv[2] = {seg.lo, seg.hi};
                 const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
+                if (count_side[seg.lo] == 0 && count_side[seg.hi] == 0)
+                    continue; // nothing to read in this segment
                 // Skip what lies in front of the segment (not asked of this level there).
                 for (uint32_t c = 0; c < classes; ++c)
                     for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
