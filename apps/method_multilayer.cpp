@@ -166,6 +166,7 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
         if (l.kind == dof::LevelKind::Aperture) {
             j["source"] = l.source;
             j["grid"] = l.grid;
+            j["cells_skipped"] = l.cells_skipped;
         }
         return j;
     };

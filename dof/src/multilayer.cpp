@@ -22,6 +22,18 @@ struct AxisTap {
     float f = 0.0f;
 };
 
+// The cells [lo, hi] that taps with a weight > 0 read along one axis.
+void readRange(const std::vector<AxisTap>& taps, uint32_t& lo, uint32_t& hi) {
+    lo = std::numeric_limits<uint32_t>::max();
+    hi = 0;
+    for (const AxisTap& t : taps) {
+        if (1.0f - t.f > 0.0f)
+            lo = std::min(lo, t.i0), hi = std::max(hi, t.i0);
+        if (t.f > 0.0f)
+            lo = std::min(lo, t.i1), hi = std::max(hi, t.i1);
+    }
+}
+
 std::vector<AxisTap> axisTaps(uint32_t pixels, float origin, float spacing, uint32_t cells) {
     std::vector<AxisTap> taps(pixels);
     const int64_t last = int64_t(cells) - 1;
@@ -44,6 +56,32 @@ struct Cursor {
     float weight = 0.0f;
     bool pieces = false; // a filtered level's cell (shareInList)
 };
+
+// The rows of cells a level's bilinear taps read on one row of pixels: cell row j0 with weight
+// 1 - f, then j1 with weight f, each kept only with a weight > 0 and fragments in it.
+struct TapRows {
+    uint32_t count = 0;
+    const uint32_t* starts[2] = {}; // the row's list starts (FragmentLevel::starts)
+    const LayerFragment* data[2] = {};
+    float weight[2] = {};
+    bool pieces = false; // a filtered level (shareInList)
+};
+
+TapRows tapRows(const FragmentLevel& level, const AxisTap& ay) {
+    TapRows t;
+    t.pieces = level.kind != LevelKind::Base;
+    const uint32_t cy[2] = {ay.i0, ay.i1};
+    const float wy[2] = {1.0f - ay.f, ay.f};
+    for (int r = 0; r < 2; ++r) {
+        if (!(wy[r] > 0.0f) || level.rows[cy[r]].empty())
+            continue;
+        t.starts[t.count] = level.starts.data() + size_t(cy[r]) * (level.width + 1);
+        t.data[t.count] = level.rows[cy[r]].data();
+        t.weight[t.count] = wy[r];
+        ++t.count;
+    }
+    return t;
+}
 
 constexpr float kOpaque = 1.0f - 1.0f / 1024.0f; // stop once the pixel is this opaque
 
@@ -171,6 +209,7 @@ MultilayerLevelStats levelStats(const FragmentLevel& l) {
     ls.max_list_length = l.max_list_length;
     ls.mean_list_length = double(l.fragments) / (double(l.width) * double(l.height));
     ls.truncated = l.truncated;
+    ls.cells_skipped = l.skipped;
     return ls;
 }
 
@@ -302,33 +341,23 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             asymmetric = asymmetric || !sameWeights(grids[0][g], grids[1][g]);
     }
 
-    // §5: plan the Y-map and T, compute the border table (§6.1), filter level by level.
+    // §5: plan the Y-map and T, compute the border table (§6.1).
     Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
     if (raster::Status s = checkLevelMemory(plan, settings, max_coc); !s.ok())
         return s;
     borders_ = levelBorders(lens, plan.variance, m2);
-    // Box levels up to the highest one T reads (all of them with box levels).
+    // Box levels up to the highest one T reads (all of them with box levels), then the
+    // aperture levels, far side then (asymmetric aperture) near side.
     uint32_t boxes_needed = uint32_t(plan.boxes.size());
     if (shaped)
         boxes_needed = plan.apertures.empty() ? 1u : plan.apertures.back().source + 1u;
     levels_.resize(boxes_needed);
-    for (uint32_t s = 1; s < boxes_needed; ++s) {
-        FragmentLevel& l = levels_[s];
-        adoptGeometry(plan.boxes[s], l);
-        filterLevel(levels_[s - 1], plan.plan, borders_, firstReader(plan, s), pool, l);
-    }
-    // Aperture levels, far side then (asymmetric aperture) near side.
+    for (uint32_t s = 1; s < boxes_needed; ++s)
+        adoptGeometry(plan.boxes[s], levels_[s]);
     const size_t shaped_count = plan.apertures.size();
     apertures_.resize(asymmetric ? 2 * shaped_count : shaped_count);
-    for (size_t side = 0; side < (asymmetric ? 2u : 1u); ++side)
-        for (size_t a = 0; a < shaped_count; ++a) {
-            FragmentLevel& l = apertures_[side * shaped_count + a];
-            adoptGeometry(plan.apertures[a], l);
-            const auto grid = std::find_if(grids[side].begin(), grids[side].end(),
-                                           [&](const ApertureGrid& g) { return g.size == l.grid; });
-            shapeLevel(levels_[l.source], *grid, plan.plan, borders_, pool, l);
-        }
-    const double ms_filter = msSince(t0);
+    for (size_t a = 0; a < apertures_.size(); ++a)
+        adoptGeometry(plan.apertures[a % shaped_count], apertures_[a]);
 
     // The levels of T on each side of the focal plane ([near, far]).
     const uint32_t n = uint32_t(plan.traversal.size()) - 1;
@@ -352,15 +381,50 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         }
     }
     const uint32_t sides = asymmetric ? 2 : 1;
-
-    // §6.1: traverse T near to far per pixel, blend the slices met front to back.
-    t0 = std::chrono::steady_clock::now();
+    const auto sideOf = [&](const LevelBorders::Segment& seg) {
+        return sides == 2 && seg.begin >= lens.focus_distance ? 1u : 0u;
+    };
+    // The bilinear taps of every level of T at the pixel centres (§6.1).
     std::vector<std::vector<AxisTap>> tx(n + 1), ty(n + 1);
     for (uint32_t s = 0; s <= n; ++s) {
         const FragmentLevel& l = *tlevel[1][s];
         tx[s] = axisTaps(width, l.origin_x, l.spacing, l.width);
         ty[s] = axisTaps(height, l.origin_y, l.spacing, l.height);
     }
+    // What the traversal reads of a level: the cells its taps reach and the segments of T
+    // that read it, merged where they touch.
+    const auto readsOf = [&](const FragmentLevel& level) {
+        LevelReads r;
+        readRange(tx[level.index], r.x0, r.x1);
+        readRange(ty[level.index], r.y0, r.y1);
+        for (const LevelBorders::Segment& seg : segments) {
+            const uint32_t side = sideOf(seg);
+            if (tlevel[side][seg.lo] != &level && tlevel[side][seg.hi] != &level)
+                continue;
+            if (!r.depths.empty() && r.depths.back().end == seg.begin)
+                r.depths.back().end = seg.end;
+            else
+                r.depths.push_back({seg.begin, seg.end});
+        }
+        return r;
+    };
+
+    // §5: filter level by level.
+    for (uint32_t s = 1; s < boxes_needed; ++s)
+        filterLevel(levels_[s - 1], plan.plan, borders_, firstReader(plan, s), pool, levels_[s]);
+    for (size_t a = 0; a < apertures_.size(); ++a) {
+        FragmentLevel& l = apertures_[a];
+        const size_t side = a / shaped_count; // 0: far, 1: near
+        const auto grid = std::find_if(grids[side].begin(), grids[side].end(),
+                                       [&](const ApertureGrid& g) { return g.size == l.grid; });
+        const LevelReads reads = readsOf(l);
+        shapeLevel(levels_[l.source], *grid, plan.plan, borders_,
+                   settings.skip_unread_cells ? &reads : nullptr, pool, l);
+    }
+    const double ms_filter = msSince(t0);
+
+    // §6.1: traverse T near to far per pixel, blend the slices met front to back.
+    t0 = std::chrono::steady_clock::now();
     out.width = width;
     out.height = height;
     out.rgba.assign(size_t(width) * height * 4, 0.0f);
@@ -375,36 +439,43 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         settings.blend == LayerBlend::Additive ? 1.0f + settings.additive_gap : 0.0f;
     std::vector<uint64_t> row_slices(height, 0);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
+        // The rows of cells every level's bilinear taps read on this row of pixels: those with
+        // a weight > 0 that hold fragments (the others add w·0 to no slice).
+        TapRows rows[2][kMaxTraversalLevels];
+        for (uint32_t side = 0; side < sides; ++side)
+            for (uint32_t s = 0; s <= n; ++s)
+                rows[side][s] = tapRows(*tlevel[side][s], ty[s][y]);
         Cursor cursors[2][kMaxTraversalLevels][4];
         uint32_t cursor_count[2][kMaxTraversalLevels];
         uint64_t slices = 0; // stored once: neighbouring rows' counts share cache lines
         for (uint32_t x = 0; x < width; ++x) {
             const size_t p = size_t(y) * width + x;
-            // Bilinear taps of every level at the pixel centre (zero weights skipped).
+            // Bilinear taps of every level at the pixel centre, in the order (i0, j0), (i1, j0),
+            // (i0, j1), (i1, j1); taps with weight 0 or an empty list are left out, since they
+            // add w·0 to every slice.
             for (uint32_t side = 0; side < sides; ++side)
                 for (uint32_t s = 0; s <= n; ++s) {
+                    const TapRows& tr = rows[side][s];
                     const AxisTap ax = tx[s][x];
-                    const AxisTap ay = ty[s][y];
-                    const uint32_t cx[4] = {ax.i0, ax.i1, ax.i0, ax.i1};
-                    const uint32_t cy[4] = {ay.i0, ay.i0, ay.i1, ay.i1};
-                    const float w[4] = {(1.0f - ax.f) * (1.0f - ay.f), ax.f * (1.0f - ay.f),
-                                        (1.0f - ax.f) * ay.f, ax.f * ay.f};
+                    const uint32_t cx[2] = {ax.i0, ax.i1};
+                    const float wx[2] = {1.0f - ax.f, ax.f};
                     uint32_t c = 0;
-                    for (int k = 0; k < 4; ++k) {
-                        if (!(w[k] > 0.0f))
-                            continue;
-                        Cursor& cur = cursors[side][s][c++];
-                        cur.data = tlevel[side][s]->list(cx[k], cy[k], cur.count);
-                        cur.next = 0;
-                        cur.weight = w[k];
-                        cur.pieces = tlevel[side][s]->kind != LevelKind::Base;
-                    }
+                    for (uint32_t r = 0; r < tr.count; ++r)
+                        for (int k = 0; k < 2; ++k) {
+                            const float w = wx[k] * tr.weight[r];
+                            const uint32_t first = tr.starts[r][cx[k]];
+                            const uint32_t count = tr.starts[r][cx[k] + 1] - first;
+                            if (!(w > 0.0f) || count == 0)
+                                continue;
+                            cursors[side][s][c++] = {tr.data[r] + first, count, 0, w, tr.pieces};
+                        }
                     cursor_count[side][s] = c;
                 }
             {
-                const Cursor& b = cursors[0][0][0];
-                if (b.count > 0)
-                    out.depth[p] = b.data[0].depth;
+                uint32_t count = 0;
+                const LayerFragment* base = levels_[0].list(x, y, count);
+                if (count > 0)
+                    out.depth[p] = base[0].depth;
             }
             float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
             float ca_g = 0.0f, ga = 0.0f, last_d = 0.0f;
@@ -412,11 +483,13 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             for (const LevelBorders::Segment& seg : segments) {
                 if (ca >= kOpaque)
                     break;
-                const uint32_t side = sides == 2 && seg.begin >= lens.focus_distance ? 1 : 0;
+                const uint32_t side = sideOf(seg);
                 Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
                 const uint32_t* count_side = cursor_count[side];
                 const uint32_t lv[2] = {seg.lo, seg.hi};
                 const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
+                if (count_side[seg.lo] == 0 && count_side[seg.hi] == 0)
+                    continue; // nothing to read in this segment
                 // Skip what lies in front of the segment (not asked of this level there).
                 for (uint32_t c = 0; c < classes; ++c)
                     for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {

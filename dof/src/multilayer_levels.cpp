@@ -24,28 +24,32 @@ double lookupVariance(double origin, double spacing, uint32_t extent) {
 
 // A level's totals from its rows' counts.
 void sumRows(const std::vector<uint32_t>& longest, const std::vector<uint64_t>& dropped,
-             FragmentLevel& level) {
+             const std::vector<uint64_t>& skipped, FragmentLevel& level) {
     level.fragments = 0;
     level.max_list_length = 0;
     level.truncated = 0;
+    level.skipped = 0;
     for (uint32_t j = 0; j < level.height; ++j) {
         level.fragments += level.rows[j].size();
         level.max_list_length = std::max(level.max_list_length, longest[j]);
         level.truncated += dropped[j];
+        level.skipped += skipped[j];
     }
 }
 
-// Fills every cell of `out` with the §5.1 merge of the lists `sources(i, j, src)` writes into
-// src (returning how many), one task per row of cells and the cells of a row in order, so the
-// bytes do not depend on the thread count. With plan.truncate, merged fragments that level
-// `border_level` of T and every level above it never ask for are dropped (truncatedAt).
-template <class Sources>
+// Fills every cell (i, j) of `out` for which `needed(i, j)` holds with the §5.1 merge of the
+// lists `sources(i, j, src)` writes into src (returning how many), one task per row of cells
+// and the cells of a row in order, so the bytes do not depend on the thread count; the other
+// cells are left empty. With plan.truncate, merged fragments that level `border_level` of T
+// and every level above it never ask for are dropped (truncatedAt).
+template <class Needed, class Sources>
 void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t border_level,
-                raster::TaskPool& pool, FragmentLevel& out, Sources&& sources) {
+                raster::TaskPool& pool, FragmentLevel& out, Needed&& needed, Sources&& sources) {
     out.rows.resize(out.height);
     out.starts.assign(size_t(out.height) * (out.width + 1), 0);
     std::vector<uint32_t> longest(out.height, 0);
     std::vector<uint64_t> dropped(out.height, 0);
+    std::vector<uint64_t> skipped(out.height, 0);
     pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
         std::vector<LayerFragment>& row = out.rows[j];
         row.clear();
@@ -57,17 +61,31 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
         // Counted on the stack and stored once: neighbouring rows' counts share cache lines.
         uint32_t row_longest = 0;
         uint64_t row_dropped = 0;
+        uint64_t row_skipped = 0;
         for (uint32_t i = 0; i < out.width; ++i) {
-            const uint32_t count = sources(i, j, src);
             starts[i] = uint32_t(row.size());
+            if (!needed(i, j)) {
+                ++row_skipped;
+                continue;
+            }
+            const uint32_t count = sources(i, j, src);
             mergeLists(src, count, plan.epsilon, plan.mean_depth, keep, row, row_dropped);
             row_longest = std::max(row_longest, uint32_t(row.size()) - starts[i]);
         }
         starts[out.width] = uint32_t(row.size());
         longest[j] = row_longest;
         dropped[j] = row_dropped;
+        skipped[j] = row_skipped;
     });
-    sumRows(longest, dropped, out);
+    sumRows(longest, dropped, skipped, out);
+}
+
+// mergeCells over every cell.
+template <class Sources>
+void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t border_level,
+                raster::TaskPool& pool, FragmentLevel& out, Sources&& sources) {
+    const auto every = [](uint32_t, uint32_t) { return true; };
+    mergeCells(plan, borders, border_level, pool, out, every, sources);
 }
 
 void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_height) {
@@ -208,7 +226,8 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
         starts[lists.width] = uint32_t(row.size());
         longest[y] = row_longest;
     });
-    sumRows(longest, std::vector<uint64_t>(lists.height, 0), out);
+    const std::vector<uint64_t> none(lists.height, 0);
+    sumRows(longest, none, none, out);
 }
 
 void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBorders& borders,
@@ -269,12 +288,53 @@ FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& gr
 }
 
 void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelPlan& plan,
-                const LevelBorders& borders, raster::TaskPool& pool, FragmentLevel& out) {
+                const LevelBorders& borders, const LevelReads* reads, raster::TaskPool& pool,
+                FragmentLevel& out) {
     FOCAL_CHECK(grid.size >= 1 && grid.size <= kMaxApertureGrid);
     const int32_t step = int32_t(out.dilation);
     const int32_t reach = int32_t(grid.size - 1) * step;
     const int32_t max_x = int32_t(box.width) - 1;
     const int32_t max_y = int32_t(box.height) - 1;
+    // Built only where read: a merged fragment lies in [d0, d0·(1 + ε)] (the product mergeLists
+    // takes as its limit) for a tap's fragment d0, so a cell can hold a fragment `reads` asks
+    // for only if one of its taps holds a d0 < end with d0·(1 + ε) >= begin. Such box cells are
+    // flagged, then the flags are widened by the taps' reach, along x on every box row
+    // (near_x) and along y per cell (the G x G square: a superset of the taps with weight).
+    const float scale = 1.0f + plan.epsilon;
+    std::vector<uint8_t> flag(reads ? size_t(box.width) * box.height : 0);
+    std::vector<uint8_t> near_x(reads ? size_t(box.height) * out.width : 0);
+    pool.parallelFor(reads ? box.height : 0, [&](uint32_t y, uint32_t) {
+        uint8_t* f = flag.data() + size_t(y) * box.width;
+        for (uint32_t x = 0; x < box.width; ++x) {
+            uint32_t count = 0;
+            const LayerFragment* l = box.list(x, y, count);
+            bool hit = false;
+            for (uint32_t k = 0; k < count && !hit; ++k)
+                for (const LevelReads::Depths& r : reads->depths)
+                    hit = hit || (l[k].depth < r.end && l[k].depth * scale >= r.begin);
+            f[x] = hit ? 1 : 0;
+        }
+    });
+    pool.parallelFor(reads ? box.height : 0, [&](uint32_t y, uint32_t) {
+        const uint8_t* f = flag.data() + size_t(y) * box.width;
+        uint8_t* o = near_x.data() + size_t(y) * out.width;
+        for (uint32_t i = 0; i < out.width; ++i) {
+            uint8_t any = 0;
+            for (int32_t a = 0; a <= reach; a += step)
+                any |= f[std::clamp(int32_t(i) + a - reach, 0, max_x)];
+            o[i] = any;
+        }
+    });
+    const auto needed = [&](uint32_t i, uint32_t j) {
+        if (!reads)
+            return true;
+        if (i < reads->x0 || i > reads->x1 || j < reads->y0 || j > reads->y1)
+            return false;
+        for (int32_t b = 0; b <= reach; b += step)
+            if (near_x[size_t(std::clamp(int32_t(j) + b - reach, 0, max_y)) * out.width + i])
+                return true;
+        return false;
+    };
     // The taps with weight, in grid order (a fixed merge order).
     struct Tap {
         int32_t a = 0;
@@ -287,21 +347,23 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
             if (grid.at(a, b) > 0.0f)
                 taps.push_back(
                     {int32_t(a) * step - reach, int32_t(b) * step - reach, grid.at(a, b)});
-    mergeCells(plan, borders, out.index, pool, out, [&](uint32_t i, uint32_t j, ListRef* src) {
-        // Empty taps add nothing to the merge (x + w·0 = x), so only the others are passed, in
-        // grid order: the same bytes, less work where the view shows background.
-        uint32_t used = 0;
-        for (const Tap& tap : taps) {
-            // Border cells clamped, as the stack's (Fig. 4).
-            const int32_t x = std::clamp(int32_t(i) + tap.a, 0, max_x);
-            const int32_t y = std::clamp(int32_t(j) + tap.b, 0, max_y);
-            src[used].data = box.list(uint32_t(x), uint32_t(y), src[used].count);
-            src[used].weight = tap.weight;
-            src[used].pieces = box.kind != LevelKind::Base;
-            used += src[used].count > 0 ? 1 : 0;
-        }
-        return used;
-    });
+    mergeCells(plan, borders, out.index, pool, out, needed,
+               [&](uint32_t i, uint32_t j, ListRef* src) {
+                   // Empty taps add nothing to the merge (x + w·0 = x), so only the others are
+                   // passed, in grid order: the same bytes, less work where the view shows
+                   // background.
+                   uint32_t used = 0;
+                   for (const Tap& tap : taps) {
+                       // Border cells clamped, as the stack's (Fig. 4).
+                       const int32_t x = std::clamp(int32_t(i) + tap.a, 0, max_x);
+                       const int32_t y = std::clamp(int32_t(j) + tap.b, 0, max_y);
+                       src[used].data = box.list(uint32_t(x), uint32_t(y), src[used].count);
+                       src[used].weight = tap.weight;
+                       src[used].pieces = box.kind != LevelKind::Base;
+                       used += src[used].count > 0 ? 1 : 0;
+                   }
+                   return used;
+               });
 }
 
 } // namespace dof

@@ -77,6 +77,7 @@ struct FragmentLevel {
     uint64_t fragments = 0; // total over all cells
     uint32_t max_list_length = 0;
     uint64_t truncated = 0; // merged fragments dropped by the §6.2 rule
+    uint64_t skipped = 0;   // cells left empty, never read by the traversal (LevelReads)
 
     double variance() const { return filter_variance + lookup_variance; }
     const LayerFragment* list(uint32_t i, uint32_t j, uint32_t& count) const {
@@ -203,6 +204,22 @@ std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const Lev
 void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBorders& borders,
                  uint32_t border_level, raster::TaskPool& pool, FragmentLevel& next);
 
+// What the traversal (§6.1) can read of a level: the cells [x0, x1] x [y0, y1] that some pixel's
+// bilinear lookup reaches, and the depth intervals [begin, end) of the segments of T that read
+// the level (a segment's cursors skip what lies in front of it and stop at its end). A merged
+// fragment anywhere else never reaches the image.
+struct LevelReads {
+    uint32_t x0 = 0;
+    uint32_t x1 = 0;
+    uint32_t y0 = 0;
+    uint32_t y1 = 0;
+    struct Depths {
+        float begin = 0.0f;
+        float end = 0.0f;
+    };
+    std::vector<Depths> depths;
+};
+
 // The geometry of the aperture-shaped level that reads `box` through `grid`: its taps sit
 // 2^box.index base pixels apart (an integer number of box cells, border cells clamped), so the
 // level covers a G·2^box.index square and keeps box's cell spacing; the image grows by the
@@ -213,9 +230,12 @@ FragmentLevel planApertureLevel(const FragmentLevel& box, const ApertureGrid& gr
 // Fills the aperture-shaped level `out` (geometry from planApertureLevel) by the §5.1 merge of
 // its G x G taps, weighted by the grid (disjoint areas: additive across taps), one task per row
 // in a fixed order. With plan.truncate, merged fragments level out.index of T never needs are
-// dropped.
+// dropped. With `reads`, only the cells that can hold a fragment it asks for are merged and the
+// others are left empty (out.skipped counts them), which the traversal cannot tell apart;
+// nullptr merges every cell.
 void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelPlan& plan,
-                const LevelBorders& borders, raster::TaskPool& pool, FragmentLevel& out);
+                const LevelBorders& borders, const LevelReads* reads, raster::TaskPool& pool,
+                FragmentLevel& out);
 
 // ---------------------------------------------------------------------------------------------
 

@@ -76,6 +76,10 @@ struct MultilayerSettings {
     // borders match m2·C(d)² to the level's variance (docs/dof/multilayer.md). Box levels
     // only: aperture levels take it from the aperture grid's samples.
     double aperture_second_moment = 0.25;
+    // Aperture levels are merged only in the cells whose fragments the traversal can read
+    // (dof::LevelReads); the other cells stay empty and the image is the same bytes. false:
+    // every cell, for looking at whole levels.
+    bool skip_unread_cells = true;
     // §4 storage of the collected lists: half colour + opacity, float depth (the paper's).
     raster::ColorFormat color_format = raster::ColorFormat::Half;
     raster::DepthFormat depth_format = raster::DepthFormat::Float32;
@@ -104,6 +108,7 @@ struct MultilayerLevelStats {
     uint32_t max_list_length = 0;
     double mean_list_length = 0.0; // fragments / cells
     uint64_t truncated = 0;        // merged fragments dropped by §6.2
+    uint64_t cells_skipped = 0;    // Aperture: cells left empty, never read (skip_unread_cells)
 };
 
 // One level of the border table T (§6.1): the level the traversal reads between its borders.

@@ -155,6 +155,55 @@ TEST(Multilayer, MergeCarriesTheMeanDepthOfWhatItMerged) {
     EXPECT_LE(out[0].depth, out[1].depth);
 }
 
+TEST(Multilayer, ShapeLevelMergesEveryCellItsReadsCanSee) {
+    // A 6x4 base whose columns alternate between depths 0.95 and 1.1, read through a 2x2 grid:
+    // cells 1-5 merge one of each (ε = 0.2) into a fragment at their mean depth, 1.025,
+    // although neither lies in the depths read, [1, 1.05). Those cells must still be merged,
+    // as in the full level; column 0 lies outside the cells read and column 6 (two clamped
+    // taps at 1.1) holds nothing read: both are left empty.
+    dof::FragmentLevel base;
+    base.width = 6;
+    base.height = 4;
+    base.rows.resize(base.height);
+    base.starts.assign(size_t(base.height) * (base.width + 1), 0);
+    for (uint32_t j = 0; j < base.height; ++j)
+        for (uint32_t i = 0; i < base.width; ++i) {
+            base.rows[j].push_back(frag(0.5f, 1.0f, i % 2 ? 1.1f : 0.95f));
+            base.starts[j * (base.width + 1) + i + 1] = i + 1;
+        }
+    dof::ApertureGrid grid;
+    grid.size = 2;
+    grid.weight = {0.25f, 0.25f, 0.25f, 0.25f};
+    dof::LevelPlan plan;
+    plan.truncate = false;
+    raster::TaskPool pool(0);
+    dof::LevelReads reads;
+    reads.x0 = 1, reads.x1 = 6, reads.y0 = 0, reads.y1 = 4;
+    reads.depths = {{1.0f, 1.05f}};
+    dof::FragmentLevel full = dof::planApertureLevel(base, grid, 1, base.width, base.height);
+    dof::FragmentLevel part = full;
+    dof::shapeLevel(base, grid, plan, {}, nullptr, pool, full);
+    dof::shapeLevel(base, grid, plan, {}, &reads, pool, part);
+    ASSERT_EQ(full.width, 7u);
+    ASSERT_EQ(full.height, 5u);
+    EXPECT_EQ(full.skipped, 0u);
+    EXPECT_EQ(part.skipped, 2u * part.height);
+    for (uint32_t j = 0; j < full.height; ++j)
+        for (uint32_t i = 0; i < full.width; ++i) {
+            uint32_t nf = 0, np = 0;
+            const dof::LayerFragment* f = full.list(i, j, nf);
+            const dof::LayerFragment* p = part.list(i, j, np);
+            ASSERT_EQ(nf, 1u);
+            if (i == 0 || i == 6) {
+                EXPECT_EQ(np, 0u) << i << "," << j;
+                continue;
+            }
+            ASSERT_EQ(np, 1u) << i << "," << j;
+            EXPECT_EQ(std::memcmp(f, p, sizeof(dof::LayerFragment)), 0) << i << "," << j;
+            EXPECT_NEAR(p->depth, 1.025f, 1e-6f);
+        }
+}
+
 // --- §6.1 border table --------------------------------------------------------------------
 
 TEST(Multilayer, BorderTableSolvesCocEqualsFilterSize) {
@@ -264,6 +313,7 @@ TEST(Multilayer, OpaqueSurfacesStayOpaqueThroughTheLevels) {
         settings.truncate = false;
         settings.stack_levels = 3;
         settings.filter = filter;
+        settings.skip_unread_cells = false; // look at every cell
         const MlRun ml =
             runMultilayer(scene, view, dof::makeThinLens(view, 12.0f, kFocus), settings);
         std::vector<const dof::FragmentLevel*> levels;
@@ -618,6 +668,44 @@ TEST(Multilayer, DeterministicAcrossThreadCounts) {
         for (uint32_t threads : {1u, 2u, 3u, 8u})
             EXPECT_EQ(hashImage(runMultilayer(*scene, view, lens, settings, threads).image), h0)
                 << config << " threads " << threads;
+    }
+}
+
+TEST(Multilayer, UnreadCellsLeftEmptyGiveTheSameBytes) {
+    // Aperture cells that cannot hold a fragment the traversal reads are not merged
+    // (dof::LevelReads); the image is the same bytes as with every cell merged, and cells are
+    // skipped. railing: a near railing, a sign in focus and a far wall; demo: a floor through
+    // every depth. Disc and triangle (near and far levels apart), mean and nearest depth,
+    // truncation off.
+    for (const char* name : {"railing", "demo"}) {
+        raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(name);
+        ASSERT_TRUE(scene.ok());
+        const raster::View view = raster::viewFromCamera(scene->cameras[0], 160, 120);
+        const dof::ThinLens lens =
+            dof::makeThinLens(view, scene->lens->aperture_radius, scene->lens->focus_distance);
+        for (const char* config : {"default", "triangle", "nearest", "truncate off"}) {
+            dof::MultilayerSettings on;
+            if (std::strcmp(config, "triangle") == 0) {
+                on.aperture.kind = dof::ApertureKind::Polygon;
+                on.aperture.blades = 3;
+            }
+            on.mean_depth = std::strcmp(config, "nearest") != 0;
+            on.truncate = std::strcmp(config, "truncate off") != 0;
+            dof::MultilayerSettings off = on;
+            off.skip_unread_cells = false;
+            const MlRun a = runMultilayer(*scene, view, lens, on, 2);
+            const MlRun b = runMultilayer(*scene, view, lens, off, 2);
+            EXPECT_EQ(hashImage(a.image), hashImage(b.image)) << name << " " << config;
+            uint64_t skipped_on = 0, skipped_off = 0, cells = 0;
+            for (const dof::MultilayerLevelStats& l : a.stats.apertures) {
+                skipped_on += l.cells_skipped;
+                cells += uint64_t(l.width) * l.height;
+            }
+            for (const dof::MultilayerLevelStats& l : b.stats.apertures)
+                skipped_off += l.cells_skipped;
+            EXPECT_GT(skipped_on, cells / 10) << name << " " << config;
+            EXPECT_EQ(skipped_off, 0u) << name << " " << config;
+        }
     }
 }
 
