@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # README command (b): install what is missing, build, and run the whole test suite:
-# the Release build (every test, warnings as errors) and the ASan+UBSan build (quick tier).
+# the Release build (every test: quick, full and stress tiers; warnings as errors), the
+# ASan+UBSan build (quick tier), ThreadSanitizer on the determinism tests, and each libFuzzer
+# target for 60 s (docs/testing.md, "What runs where").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install-deps.sh
@@ -11,4 +13,8 @@ ctest --preset release -j"$jobs"
 cmake --preset asan-ubsan >/dev/null
 cmake --build --preset asan-ubsan --target focal focal_unit_tests -- -j"$jobs"
 ctest --preset asan-ubsan -j"$jobs" -L quick
+cmake --preset tsan >/dev/null
+cmake --build --preset tsan --target focal focal_full_tests -- -j"$jobs"
+TSAN_OPTIONS="halt_on_error=1" ctest --preset tsan -j"$jobs" -R '^Scenes/Determinism\.'
+tools/fuzz.sh 60
 echo "test: all suites passed"
