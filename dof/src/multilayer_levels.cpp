@@ -335,35 +335,39 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
                 return true;
         return false;
     };
-    // The taps with weight, in grid order (a fixed merge order).
-    struct Tap {
-        int32_t a = 0;
-        int32_t b = 0;
-        float weight = 0.0f;
-    };
-    std::vector<Tap> taps;
-    for (uint32_t b = 0; b < grid.size; ++b)
-        for (uint32_t a = 0; a < grid.size; ++a)
-            if (grid.at(a, b) > 0.0f)
-                taps.push_back(
-                    {int32_t(a) * step - reach, int32_t(b) * step - reach, grid.at(a, b)});
-    mergeCells(plan, borders, out.index, pool, out, needed,
-               [&](uint32_t i, uint32_t j, ListRef* src) {
-                   // Empty taps add nothing to the merge (x + w·0 = x), so only the others are
-                   // passed, in grid order: the same bytes, less work where the view shows
-                   // background.
-                   uint32_t used = 0;
-                   for (const Tap& tap : taps) {
-                       // Border cells clamped, as the stack's (Fig. 4).
-                       const int32_t x = std::clamp(int32_t(i) + tap.a, 0, max_x);
-                       const int32_t y = std::clamp(int32_t(j) + tap.b, 0, max_y);
-                       src[used].data = box.list(uint32_t(x), uint32_t(y), src[used].count);
-                       src[used].weight = tap.weight;
-                       src[used].pieces = box.kind != LevelKind::Base;
-                       used += src[used].count > 0 ? 1 : 0;
-                   }
-                   return used;
-               });
+    // Every box row's list starts and fragments, looked up once instead of per tap.
+    std::vector<const uint32_t*> row_starts(box.height);
+    std::vector<const LayerFragment*> row_data(box.height);
+    for (uint32_t y = 0; y < box.height; ++y) {
+        row_starts[y] = box.starts.data() + size_t(y) * (box.width + 1);
+        row_data[y] = box.rows[y].data();
+    }
+    const bool pieces = box.kind != LevelKind::Base;
+    mergeCells(
+        plan, borders, out.index, pool, out, needed, [&](uint32_t i, uint32_t j, ListRef* src) {
+            // The taps with weight in grid order (a fixed merge order). Empty taps add
+            // nothing to the merge (x + w·0 = x), so only the others are passed: the
+            // same bytes, less work where the view shows background.
+            uint32_t used = 0;
+            // Border cells clamped, as the stack's (Fig. 4); inside, no column is.
+            const bool inside = int32_t(i) >= reach && int32_t(i) <= max_x;
+            for (uint32_t b = 0; b < grid.size; ++b) {
+                const int32_t y = std::clamp(int32_t(j) + int32_t(b) * step - reach, 0, max_y);
+                const uint32_t* st = row_starts[size_t(y)];
+                if (st[0] == st[box.width])
+                    continue; // an empty row
+                for (uint32_t a = 0; a < grid.size; ++a) {
+                    const float w = grid.at(a, b);
+                    const int32_t xt = int32_t(i) + int32_t(a) * step - reach;
+                    const uint32_t x = uint32_t(inside ? xt : std::clamp(xt, 0, max_x));
+                    const uint32_t count = st[x + 1] - st[x];
+                    if (!(w > 0.0f) || count == 0)
+                        continue;
+                    src[used++] = {row_data[size_t(y)] + st[x], count, w, pieces};
+                }
+            }
+            return used;
+        });
 }
 
 } // namespace dof

@@ -243,40 +243,50 @@ template <class Keep>
 void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
                 Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped) {
     FOCAL_CHECK(list_count <= kMaxMergeLists);
-    uint32_t cursor[kMaxMergeLists];
-    std::fill_n(cursor, list_count, 0u);
+    // The lists that still hold fragments, in list order, and their next fragment. Only the
+    // lists with a fragment in a merge window are visited: another would add w·0 = +0 to sums
+    // that start at +0 and so are never -0, which leaves them unchanged (the same bytes).
+    uint8_t live[kMaxMergeLists];
+    const LayerFragment* next[kMaxMergeLists];
+    uint32_t live_count = 0;
+    for (uint32_t k = 0; k < list_count; ++k)
+        if (lists[k].count > 0) {
+            next[k] = lists[k].data;
+            live[live_count++] = uint8_t(k);
+        }
     const float scale = 1.0f + epsilon;
-    for (;;) {
-        // Closest head over all lists (ties: the lower list index, a fixed order).
-        float d0 = 0.0f;
-        bool any = false;
-        for (uint32_t k = 0; k < list_count; ++k)
-            if (cursor[k] < lists[k].count) {
-                const float d = lists[k].data[cursor[k]].depth;
-                if (!any || d < d0)
-                    d0 = d, any = true;
-            }
-        if (!any)
-            return;
+    while (live_count > 0) {
+        // Closest head over all lists (a value: ties do not matter).
+        float d0 = next[live[0]]->depth;
+        for (uint32_t m = 1; m < live_count; ++m)
+            d0 = std::min(d0, next[live[m]]->depth);
         const float limit = d0 * scale;
         LayerFragment merged;
         float depth_sum = 0.0f; // Σ w·(visible opacity)·depth, for the mean depth
-        for (uint32_t k = 0; k < list_count; ++k) {
-            // Within list k, front to back (§5.1, first case).
-            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
-            uint32_t c = cursor[k];
-            const LayerFragment* l = lists[k].data;
-            for (; c < lists[k].count && l[c].depth <= limit; ++c) {
-                const float t = shareInList(l[c], lists[k].pieces, pa);
-                pr += t * l[c].r, pg += t * l[c].g, pb += t * l[c].b, pa += t * l[c].a;
-                pd += t * l[c].a * l[c].depth;
+        uint32_t kept = 0;
+        for (uint32_t m = 0; m < live_count; ++m) {
+            const uint32_t k = live[m];
+            const LayerFragment* f = next[k];
+            const LayerFragment* end = lists[k].data + lists[k].count;
+            if (f->depth <= limit) {
+                // Within list k, front to back (§5.1, first case).
+                float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
+                do {
+                    const float t = shareInList(*f, lists[k].pieces, pa);
+                    pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
+                    pd += t * f->a * f->depth;
+                    ++f;
+                } while (f != end && f->depth <= limit);
+                next[k] = f;
+                // Additive blending across lists (§5.1, second case), weighted.
+                const float w = lists[k].weight;
+                merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
+                depth_sum += w * pd;
             }
-            cursor[k] = c;
-            // Additive blending across lists (§5.1, second case), weighted.
-            const float w = lists[k].weight;
-            merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
-            depth_sum += w * pd;
+            if (f != end)
+                live[kept++] = uint8_t(k);
         }
+        live_count = kept;
         if (!(merged.a > 0.0f))
             continue;
         merged.depth = mean_depth ? std::clamp(depth_sum / merged.a, d0, limit) : d0;
