@@ -361,6 +361,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     }
     dof::ShadingInputs shading;
     shading.scene = &in.scene;
+    shading.simd = in.options.simd;
     raster::Result<dof::MultiviewStats> r =
         dof::renderMultiview(in.view, in.lens, in.lens_samples, s, shading, in.scene.background,
                              pin, lay, in.pool, out.rgba, &pinhole, &layers);

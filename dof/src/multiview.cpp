@@ -1336,7 +1336,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     tr.background = background;
     std::optional<raster::SurfaceShader> shader;
     if (shade) {
-        shader.emplace(*shading.scene, view);
+        shader.emplace(*shading.scene, view, shading.simd);
         tr.shader = &*shader;
     }
     // C as an affine function of stored depth D: 1/d = 1/n - D (1/n - 1/f) (camera.h), so

@@ -237,6 +237,7 @@ std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fi
 // rasterizer's model (raster::SurfaceShader), plus MultiviewSettings::env_map reflections.
 struct ShadingInputs {
     const raster::Scene* scene = nullptr;
+    bool simd = true; // the lighting kernel of the per-ray shading: AVX2 or the scalar reference
 };
 
 // §4.3-§5 on given layers: traces every pixel's lens rays and writes linear RGBA into `rgba`
