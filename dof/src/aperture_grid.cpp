@@ -5,15 +5,23 @@
 
 namespace dof {
 
+raster::Result<LensSampleSet> apertureGridSamples(const ApertureShape& shape) {
+    constexpr uint32_t kSamples = 1u << 16; // the weights' error is ~1/256 of a cell's share
+    return LensSampleSet::create(shape, LensPattern::Hammersley, kSamples, 0);
+}
+
 raster::Result<ApertureGrid> apertureGrid(const ApertureShape& shape, uint32_t size,
                                           FocalSide side) {
-    if (size == 0 || size > 64)
-        return raster::Status::error("aperture grid: the cell count per axis must be in [1, 64]");
-    constexpr uint32_t kSamples = 1u << 16; // the weights' error is ~1/256 of a cell's share
-    raster::Result<LensSampleSet> set =
-        LensSampleSet::create(shape, LensPattern::Hammersley, kSamples, 0);
+    raster::Result<LensSampleSet> set = apertureGridSamples(shape);
     if (!set.ok())
         return set.status();
+    return apertureGrid(*set, shape, size, side);
+}
+
+raster::Result<ApertureGrid> apertureGrid(const LensSampleSet& samples, const ApertureShape& shape,
+                                          uint32_t size, FocalSide side) {
+    if (size == 0 || size > 64)
+        return raster::Status::error("aperture grid: the cell count per axis must be in [1, 64]");
     ApertureGrid grid;
     grid.size = size;
     // The mass behind the focal plane, where image offset = R·(-v.x, +v.y) (dof/lens.h).
@@ -23,7 +31,7 @@ raster::Result<ApertureGrid> apertureGrid(const ApertureShape& shape, uint32_t s
         const double c = std::floor((o + 1.0) * 0.5 * double(size));
         return uint32_t(std::clamp(c, 0.0, double(size - 1)));
     };
-    for (const LensSample& s : set->samples()) {
+    for (const LensSample& s : samples.samples()) {
         const double ox = -double(s.position.x);
         const double oy = double(s.position.y);
         mass[size_t(cell(oy)) * size + cell(ox)] += double(s.weight);

@@ -329,9 +329,14 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     double m2 = settings.aperture_second_moment;
     bool asymmetric = false;
     if (shaped) {
+        // One set of samples for every grid: making it costs more than binning it.
+        raster::Result<LensSampleSet> samples = apertureGridSamples(settings.aperture);
+        if (!samples.ok())
+            return raster::Status::error("multilayer: " + samples.status().message());
         for (uint32_t size : settings.aperture_grids)
             for (FocalSide side : {FocalSide::Far, FocalSide::Near}) {
-                raster::Result<ApertureGrid> r = apertureGrid(settings.aperture, size, side);
+                raster::Result<ApertureGrid> r =
+                    apertureGrid(*samples, settings.aperture, size, side);
                 if (!r.ok())
                     return raster::Status::error("multilayer: " + r.status().message());
                 grids[side == FocalSide::Far ? 0 : 1].push_back(std::move(*r));

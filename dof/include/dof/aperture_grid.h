@@ -41,6 +41,11 @@ struct ApertureGrid {
 raster::Result<ApertureGrid> apertureGrid(const ApertureShape& shape, uint32_t size,
                                           FocalSide side);
 
+// The same from samples made once by apertureGridSamples(shape), for several grids of one shape.
+raster::Result<LensSampleSet> apertureGridSamples(const ApertureShape& shape);
+raster::Result<ApertureGrid> apertureGrid(const LensSampleSet& samples, const ApertureShape& shape,
+                                          uint32_t size, FocalSide side);
+
 // True when the two grids hold the same weights (an aperture symmetric under a half turn).
 bool sameWeights(const ApertureGrid& a, const ApertureGrid& b);
 
