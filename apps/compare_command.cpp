@@ -118,8 +118,9 @@ void printReport(const CompareArgs& args, const ImageData& a, const dof::ErrorMe
     row("SSIM", [&](const dof::ErrorMetrics& m) { return fmt("%.5f", m.ssim); });
     row("mean |err|", [&](const dof::ErrorMetrics& m) { return fmt("%.6f", m.mean_abs_error); });
     row("max |err|", [&](const dof::ErrorMetrics& m) { return fmt("%.6f", m.max_abs_error); });
-    std::printf("%-14s %16s\n", "differing px",
-                (std::to_string(differing) + " (> " + formatValue(double(args.tolerance)) + ")").c_str());
+    std::printf(
+        "%-14s %16s\n", "differing px",
+        (std::to_string(differing) + " (> " + formatValue(double(args.tolerance)) + ")").c_str());
     if (!args.depth.empty() && !band)
         std::printf("depth band: no depth discontinuities in %s\n", args.depth.c_str());
     if (wrote_diff)
