@@ -3,22 +3,32 @@
 # the Release build (every test: quick, full, golden and stress tiers; warnings as errors), the
 # ASan+UBSan build (quick tier), a clang++ Release build of focal and the golden tests (which must
 # match the same goldens as g++), ThreadSanitizer on the pinhole determinism sweeps, and each
-# libFuzzer target for 60 s (docs/testing.md, "What runs where").
+# libFuzzer target for 60 s (docs/testing.md, "What runs where"). Each step prints its wall time,
+# so a slow CI run shows where the time went.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-tools/install-deps.sh
+start=$SECONDS
+step() { # NAME COMMAND...: run it, then print how long it took
+  local name=$1 t0=$SECONDS
+  shift
+  "$@"
+  echo "test: $name: $((SECONDS - t0)) s (total $((SECONDS - start)) s)"
+}
 jobs=$(nproc)
+step "install" tools/install-deps.sh
 cmake --preset release >/dev/null
-cmake --build --preset release -- -j"$jobs"
-ctest --preset release -j"$jobs"
+step "release build" cmake --build --preset release -- -j"$jobs"
+step "release tests" ctest --preset release -j"$jobs"
 cmake --preset asan-ubsan >/dev/null
-cmake --build --preset asan-ubsan --target focal focal_unit_tests -- -j"$jobs"
-ctest --preset asan-ubsan -j"$jobs" -L quick
+step "asan-ubsan build" cmake --build --preset asan-ubsan --target focal focal_unit_tests -- -j"$jobs"
+step "asan-ubsan quick tier" ctest --preset asan-ubsan -j"$jobs" -L quick
 cmake --preset clang-release >/dev/null
-cmake --build --preset clang-release -- -j"$jobs"   # the preset's targets: focal, focal_golden_tests
-ctest --preset clang-release -j"$jobs"              # the preset's filter: label golden
+# The preset's targets: focal, focal_golden_tests; its test filter: label golden.
+step "clang build" cmake --build --preset clang-release -- -j"$jobs"
+step "clang golden tier" ctest --preset clang-release -j"$jobs"
 cmake --preset tsan >/dev/null
-cmake --build --preset tsan --target focal focal_golden_tests -- -j"$jobs"
-TSAN_OPTIONS="halt_on_error=1" ctest --preset tsan -j"$jobs" --no-tests=error -R '^Scenes/Determinism\.'
-tools/fuzz.sh 60
-echo "test: all suites passed"
+step "tsan build" cmake --build --preset tsan --target focal focal_golden_tests -- -j"$jobs"
+step "tsan determinism" env TSAN_OPTIONS="halt_on_error=1" \
+  ctest --preset tsan -j"$jobs" --no-tests=error -R '^Scenes/Determinism\.'
+step "fuzz build and run" tools/fuzz.sh 60
+echo "test: all suites passed in $((SECONDS - start)) s"

@@ -18,9 +18,9 @@ double invFar(const View& view) {
     return view.zfar > 0.0f ? 1.0 / double(view.zfar) : 0.0;
 }
 
-std::string number(double v) {
+std::string number(float v) {
     char text[32];
-    std::snprintf(text, sizeof(text), "%.3g", v);
+    std::snprintf(text, sizeof(text), "%.3g", double(v));
     return text;
 }
 
