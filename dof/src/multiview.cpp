@@ -1521,19 +1521,21 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                 const std::vector<float>& src = mip[lv - 1];
                 std::vector<float>& dst = mip[lv];
                 dst.resize(size_t(cw) * ch * C);
-                for (uint32_t y = 0; y < ch; ++y)
-                    for (uint32_t x = 0; x < cw; ++x) {
-                        const uint32_t x0 = std::min(2 * x, pw - 1),
-                                       x1 = std::min(2 * x + 1, pw - 1);
-                        const uint32_t y0 = std::min(2 * y, ph - 1),
-                                       y1 = std::min(2 * y + 1, ph - 1);
+                for (uint32_t y = 0; y < ch; ++y) {
+                    const float* r0 = src.data() + size_t(std::min(2 * y, ph - 1)) * pw * C;
+                    const float* r1 = src.data() + size_t(std::min(2 * y + 1, ph - 1)) * pw * C;
+                    float* o = dst.data() + size_t(y) * cw * C;
+                    auto texel = [&](uint32_t x, uint32_t x0, uint32_t x1) {
                         for (uint32_t c = 0; c < C; ++c)
-                            dst[(size_t(y) * cw + x) * C + c] =
-                                0.25f * (src[(size_t(y0) * pw + x0) * C + c] +
-                                         src[(size_t(y0) * pw + x1) * C + c] +
-                                         src[(size_t(y1) * pw + x0) * C + c] +
-                                         src[(size_t(y1) * pw + x1) * C + c]);
-                    }
+                            o[x * C + c] = 0.25f * (r0[x0 * C + c] + r0[x1 * C + c] +
+                                                    r1[x0 * C + c] + r1[x1 * C + c]);
+                    };
+                    // Only an odd level's last column clamps its right neighbour.
+                    for (uint32_t x = 0; x < pw / 2; ++x)
+                        texel(x, 2 * x, 2 * x + 1);
+                    for (uint32_t x = pw / 2; x < cw; ++x)
+                        texel(x, std::min(2 * x, pw - 1), std::min(2 * x + 1, pw - 1));
+                }
             }
         };
         pool.parallelFor(m, [&](uint32_t l, uint32_t) {

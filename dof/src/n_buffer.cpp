@@ -29,10 +29,13 @@ void buildNBuffer(const float* depth, uint32_t width, uint32_t height, uint32_t 
             const float* r0 = prev.data() + size_t(y) * width;
             const float* r1 = prev.data() + size_t(y1) * width;
             float* o = cur.data() + size_t(y) * width;
-            for (uint32_t x = 0; x < width; ++x) {
-                const uint32_t x1 = std::min(x + h, width - 1);
-                o[x] = std::min(std::min(r0[x], r0[x1]), std::min(r1[x], r1[x1]));
-            }
+            // Columns whose partner x + h lies inside the row need no clamp (a loop the
+            // compiler vectorizes); the last h columns take the last column as partner.
+            const uint32_t inner = width > h ? width - h : 0;
+            for (uint32_t x = 0; x < inner; ++x)
+                o[x] = std::min(std::min(r0[x], r0[x + h]), std::min(r1[x], r1[x + h]));
+            for (uint32_t x = inner; x < width; ++x)
+                o[x] = std::min(std::min(r0[x], r0[width - 1]), std::min(r1[x], r1[width - 1]));
         }
     }
 }
