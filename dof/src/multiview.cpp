@@ -1113,6 +1113,48 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
         }
 }
 
+// traceTile compiled twice, for the baseline x86-64 and for AVX2 (the raster kernels' written-
+// once, compiled-twice form, here by function attributes): `flatten` inlines everything it calls
+// (the tracer's functions and the standard library's inline code) into each copy, so each is
+// compiled whole for its target, and no code built for AVX2 is shared with the baseline copy.
+// Without FMA the AVX2 copy computes the same IEEE operations in the same order (the build
+// forbids contraction and reassociation), so the bytes are the same; what differs is the
+// instructions chosen (a floor is one `vroundss` instead of a dozen SSE2 instructions, selects
+// are blends). The scalar copy is the reference: ShadingInputs::simd = false (`--no-simd`).
+#if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
+#define FOCAL_MULTIVIEW_AVX2 1
+#endif
+using TraceTileFn = void (*)(const Tracer&, uint32_t, uint32_t, uint32_t, uint32_t,
+                             const uint32_t*, uint32_t, RayState*, PixelLayers*, float*,
+                             TileCounters&);
+
+__attribute__((flatten)) void traceTileBaseline(const Tracer& tr, uint32_t x0, uint32_t x1,
+                                                uint32_t y0, uint32_t y1,
+                                                const uint32_t* tile_layers,
+                                                uint32_t tile_layer_count, RayState* rays,
+                                                PixelLayers* pixel_layers, float* rgba,
+                                                TileCounters& cnt) {
+    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt);
+}
+
+#ifdef FOCAL_MULTIVIEW_AVX2
+__attribute__((flatten, target("avx2,no-fma"))) void
+traceTileAvx2(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+              const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
+              PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
+    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt);
+}
+#endif
+
+TraceTileFn traceTileFor(bool simd) {
+#ifdef FOCAL_MULTIVIEW_AVX2
+    if (simd && __builtin_cpu_supports("avx2"))
+        return traceTileAvx2;
+#endif
+    (void)simd;
+    return traceTileBaseline;
+}
+
 } // namespace
 
 Status validate(const MultiviewSettings& s, uint32_t sample_count) {
@@ -1660,6 +1702,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     // Per worker: the states of one tile's rays and pixels.
     std::vector<RayState> ray_states(size_t(pool.workerCount()) * ts * ts * samples.size());
     std::vector<PixelLayers> pixel_layers(size_t(pool.workerCount()) * ts * ts);
+    const TraceTileFn trace_tile = traceTileFor(shading.simd);
     pool.parallelFor(tiles_x * tiles_y, [&](uint32_t tile, uint32_t worker) {
         // Counted on the stack, stored once: neighbouring tiles' counters share cache lines,
         // and the two workers usually trace neighbouring tiles.
@@ -1678,9 +1721,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             }
             tile_layers[count++] = l;
         }
-        traceTile(tr, x0, x1, y0, y1, tile_layers.data(), count,
-                  ray_states.data() + size_t(worker) * ts * ts * samples.size(),
-                  pixel_layers.data() + size_t(worker) * ts * ts, rgba.data(), cnt);
+        trace_tile(tr, x0, x1, y0, y1, tile_layers.data(), count,
+                   ray_states.data() + size_t(worker) * ts * ts * samples.size(),
+                   pixel_layers.data() + size_t(worker) * ts * ts, rgba.data(), cnt);
         counters[tile] = cnt;
     });
     for (const TileCounters& c : counters) {

@@ -237,7 +237,9 @@ std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fi
 // rasterizer's model (raster::SurfaceShader), plus MultiviewSettings::env_map reflections.
 struct ShadingInputs {
     const raster::Scene* scene = nullptr;
-    bool simd = true; // the lighting kernel of the per-ray shading: AVX2 or the scalar reference
+    // The SIMD switch of the tracing (`--no-simd` turns it off): the tracer's AVX2 build and the
+    // lighting kernel of the per-ray shading, or the baseline build and the scalar reference.
+    bool simd = true;
 };
 
 // §4.3-§5 on given layers: traces every pixel's lens rays and writes linear RGBA into `rgba`
