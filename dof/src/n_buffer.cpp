@@ -1,6 +1,7 @@
 #include <dof/n_buffer.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace dof {
@@ -41,10 +42,9 @@ void buildNBuffer(const float* depth, uint32_t width, uint32_t height, uint32_t 
 }
 
 uint32_t nBufferLevelFor(const NBuffer& nb, uint32_t size) {
-    uint32_t n = 0;
-    while (n + 1 < nb.levelCount() && (uint64_t(2) << n) <= size)
-        ++n;
-    return n;
+    // floor(log2(size)) (0 for sizes 0 and 1), at most the last level.
+    const uint32_t n = size > 1 ? uint32_t(std::bit_width(size)) - 1 : 0;
+    return std::min(n, nb.levelCount() > 0 ? nb.levelCount() - 1 : 0);
 }
 
 float nBufferMin(const NBuffer& nb, int64_t x0, int64_t y0, int64_t size) {
