@@ -54,10 +54,13 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         in.z[k] = t.z[k];
     }
     in.inv_area2 = tr.inv_area2;
-    in.valid = 0;
-    for (int l = 0; l < kQuadLanes; ++l) {
-        const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
-        in.valid |= uint32_t(x < int32_t(ctx.grid.width) && y < int32_t(ctx.grid.height)) << l;
+    in.valid = 0xffu;
+    if (qx + 3 >= int32_t(ctx.grid.width) || qy + 1 >= int32_t(ctx.grid.height)) {
+        in.valid = 0; // on the right or bottom border of the viewport
+        for (int l = 0; l < kQuadLanes; ++l) {
+            const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
+            in.valid |= uint32_t(x < int32_t(ctx.grid.width) && y < int32_t(ctx.grid.height)) << l;
+        }
     }
     QuadOutput q;
     ctx.kernel(in, q);
@@ -108,7 +111,8 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, emissive_texel);
 
     // Per lane that passed: base colour (factor x vertex colour x texture), alpha test.
-    Fragment frags[kQuadLanes];
+    const bool blend = m.alpha_mode == AlphaMode::Blend;
+    float alpha[kQuadLanes];
     int lane_of[kQuadLanes];
     glm::vec3 normals[kQuadLanes];
     int active = 0;
@@ -116,9 +120,6 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
     for (int l = 0; l < kQuadLanes; ++l) {
         if (!(tested & (1u << l)))
             continue;
-        Fragment& frag = frags[active];
-        frag.z = q.z[l];
-        frag.distance = q.distance[l];
         const float b[3] = {q.persp[0][l], q.persp[1][l], q.persp[2][l]};
         const glm::vec4 vcolor =
             tr.has_colors ? b[0] * tr.v[0]->color + b[1] * tr.v[1]->color + b[2] * tr.v[2]->color
@@ -131,7 +132,7 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
             continue;
         // A BLEND fragment of opacity 0 changes nothing: dropped like a masked one, so it takes
         // no fragment-list slot and no transparent depth.
-        if (m.alpha_mode == AlphaMode::Blend && !(base.a > 0.0f))
+        if (blend && !(base.a > 0.0f))
             continue;
         ++counters.passed;
         const glm::vec3 world =
@@ -151,9 +152,7 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
             light.world[c][active] = world[c];
             light.normal[c][active] = normal[c];
         }
-        frag.blend = m.alpha_mode == AlphaMode::Blend;
-        frag.color.a = frag.blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f;
-        frag.primitive_id = t.primitive_id;
+        alpha[active] = blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f;
         normals[active] = normal;
         lane_of[active++] = l;
     }
@@ -170,7 +169,12 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
     for (int i = 0; i < active; ++i) {
         const int l = lane_of[i];
         const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
-        Fragment& frag = frags[i];
+        Fragment frag;
+        frag.z = q.z[l];
+        frag.distance = q.distance[l];
+        frag.blend = blend;
+        frag.color.a = alpha[i];
+        frag.primitive_id = t.primitive_id;
         for (int c = 0; c < 3; ++c)
             frag.color[c] = unlit ? light.albedo[c][i] + light.emissive[c][i] : light.rgb[c][i];
         if (sink.wants_gbuffer) {
