@@ -56,7 +56,7 @@ TextureRoles sampledTextureRoles(ShadingMode) {
 }
 
 void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& in,
-                    float rgba[4][kTextureLanes]) {
+                    uint32_t lane_mask, float rgba[4][kTextureLanes]) {
     const Image& image = ctx.scene->images[size_t(ref.image)];
     const Sampler& sampler = samplerOf(*ctx.scene, ref);
     const float lod[2] = {levelOfDetail(ref, image, in.duv_dx[0], in.duv_dy[0]),
@@ -66,8 +66,14 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
         const glm::vec2 uv = transformUv(ref, in.uv[l]);
         lanes.u[l] = uv.x, lanes.v[l] = uv.y;
     }
-    if (!fitsTextureKernel(image.levels[0])) { // beyond the kernel's integers: one by one
+    // One by one when at most kFewLanes lanes are asked for (a kernel call costs about as much as
+    // three one-fragment lookups; callgrind on ToyCar) or the image is beyond the kernel's
+    // integers.
+    constexpr int kFewLanes = 2;
+    if (__builtin_popcount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
         for (int l = 0; l < kTextureLanes; ++l) {
+            if (!(lane_mask & (1u << l)))
+                continue;
             const glm::vec4 c =
                 sampleImage(image, sampler, ctx.filter, {lanes.u[l], lanes.v[l]}, lod[l / 4]);
             for (int k = 0; k < 4; ++k)

@@ -43,12 +43,13 @@ struct QuadPairUv {
     glm::vec2 duv_dx[2], duv_dy[2];
 };
 
-// `ref`'s texture (texture transform, level of detail, sampler) at every lane of a quad pair:
-// linear RGBA per lane, the same bits as a lookup of that one fragment. One level of detail per
-// quad, as GPUs compute it from the quad's derivatives; the lanes are filtered together by the
-// texture kernel.
+// `ref`'s texture (texture transform, level of detail, sampler) at the lanes of a quad pair set
+// in `lanes` (other lanes' rgba may be left unset): linear RGBA per lane, the same bits as a
+// lookup of that one fragment. One level of detail per quad, as GPUs compute it from the quad's
+// derivatives. The lanes are filtered together by the texture kernel, or one by one when only
+// a few are asked for (the kernel's cost does not depend on how many lanes are used).
 void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
-                    float rgba[4][kTextureLanes]);
+                    uint32_t lanes, float rgba[4][kTextureLanes]);
 
 // Emissive radiance: factor x emissive texture.
 glm::vec3 emissiveColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv);

@@ -100,15 +100,15 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
     if (tested == 0)
         return;
 
-    // The textures at all 8 lanes at once (the texture kernel).
+    // The textures at the lanes that passed, together (the texture kernel).
     const bool base_textured = m.base_color_texture.image >= 0;
     const bool emissive_textured =
         m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
     float base_texel[4][kTextureLanes], emissive_texel[4][kTextureLanes];
     if (base_textured)
-        sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, base_texel);
+        sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, tested, base_texel);
     if (emissive_textured)
-        sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, emissive_texel);
+        sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, tested, emissive_texel);
 
     // Per lane that passed: base colour (factor x vertex colour x texture), alpha test.
     const bool blend = m.alpha_mode == AlphaMode::Blend;
