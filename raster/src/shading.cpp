@@ -50,8 +50,9 @@ TextureLevel kernelLevel(const MipLevel& level) {
 } // namespace
 
 TextureRoles sampledTextureRoles(ShadingMode) {
-    // baseColor() and emissiveColor() are the only texture reads, and every mode makes them
-    // (lighting takes metallic and roughness from the material's factors alone).
+    // The base colour and emissive textures are the only texture reads (sampleQuadPair,
+    // emissiveColor), and every mode makes them (lighting takes metallic and roughness from the
+    // material's factors alone).
     return TextureRoles{} | TextureRole::BaseColor | TextureRole::Emissive;
 }
 
