@@ -105,8 +105,8 @@ struct ChunkContext {
 
 // Snaps, culls and appends one triangle whose vertices are all inside the guard band.
 void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& draw,
-                   bool double_sided, uint32_t triangle, float max_distance,
-                   const ScreenVertex s[3], const uint32_t ref[3]) {
+                   uint32_t triangle, float max_distance, const ScreenVertex s[3],
+                   const uint32_t ref[3]) {
     int64_t area2 =
         int64_t(s[1].x - s[0].x) * (s[2].y - s[0].y) - int64_t(s[1].y - s[0].y) * (s[2].x - s[0].x);
     if (area2 == 0) {
@@ -115,7 +115,7 @@ void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& dr
     }
     // y points down on screen, so counter-clockwise in NDC (glTF's front face) has area2 < 0.
     const bool front_facing = (area2 < 0) != draw.mirrored;
-    if (!front_facing && !double_sided) {
+    if (!front_facing && !draw.double_sided) {
         ++chunk.triangles_culled;
         return;
     }
@@ -158,7 +158,6 @@ void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& dr
 void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& draw,
                      uint32_t triangle) {
     const Primitive& prim = ctx.scene.meshes[draw.mesh].primitives[draw.primitive];
-    const Material& material = materialOf(ctx.scene, prim);
     uint32_t ref[3];
     const ShadeVertex* v[3];
     const VertexCodes* code[3];
@@ -179,7 +178,7 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
     if (crossing == 0) {
         const ScreenVertex s[3] = {ctx.state.screen[ref[0]], ctx.state.screen[ref[1]],
                                    ctx.state.screen[ref[2]]};
-        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, max_distance, s, ref);
+        setupTriangle(ctx, chunk, draw, triangle, max_distance, s, ref);
         return;
     }
     // True clipping: only against the planes this triangle crosses (near/far, guard band).
@@ -200,8 +199,7 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
         const ScreenVertex fan[3] = {toScreen(poly[0].clip, ctx.half_w, ctx.half_h),
                                      toScreen(poly[i].clip, ctx.half_w, ctx.half_h),
                                      toScreen(poly[i + 1].clip, ctx.half_w, ctx.half_h)};
-        setupTriangle(ctx, chunk, draw, material.double_sided, triangle, max_distance, fan,
-                      fan_ref);
+        setupTriangle(ctx, chunk, draw, triangle, max_distance, fan, fan_ref);
     }
 }
 
@@ -222,8 +220,8 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
             const Primitive& prim = mesh.primitives[p];
             if (prim.indices.size() < 3)
                 continue;
-            state.draws.push_back(
-                {i, inst.mesh, p, vertex_count, triangle_count, mirrored, normal_matrix});
+            state.draws.push_back({i, inst.mesh, p, vertex_count, triangle_count, mirrored,
+                                   materialOf(scene, prim).double_sided, normal_matrix});
             vertex_count += uint32_t(prim.positions.size());
             triangle_count += prim.indices.size() / 3;
         }

@@ -41,6 +41,7 @@ struct Draw {
     uint32_t first_vertex = 0;     // into GeometryState::vertices
     uint64_t first_triangle = 0;   // submission index of its first triangle
     bool mirrored = false;         // negative determinant: winding flips
+    bool double_sided = false;     // the material's: back faces are not culled
     glm::mat3 normal_matrix{1.0f}; // inverse transpose of the instance's upper 3x3
 };
 

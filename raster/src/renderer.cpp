@@ -130,6 +130,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.lights = st.lights.data();
     st.ctx.shade.light_count = uint32_t(st.lights.size());
     st.ctx.shade.light_kernel = selectLightKernel(options.simd);
+    st.ctx.shade.texture_kernel = selectTextureKernel(options.simd);
     st.tile_counters.assign(st.ctx.grid.count(), TileCounters{});
     if (stats) {
         *stats = FrameStats{};

@@ -11,37 +11,100 @@ namespace raster {
 
 namespace {
 
-glm::vec4 sampleRef(const ShadeContext& ctx, const TextureRef& ref, const UvFootprint& fp) {
-    const Scene& scene = *ctx.scene;
-    const Image& image = scene.images[size_t(ref.image)];
+const Sampler& samplerOf(const Scene& scene, const TextureRef& ref) {
     static const Sampler kDefaultSampler{};
-    const Sampler& sampler =
-        ref.sampler >= 0 ? scene.samplers[size_t(ref.sampler)] : kDefaultSampler;
-    // KHR_texture_transform: uv' = M (u, v, 1); derivatives transform by the linear part.
-    const glm::vec2 uv = glm::vec2(ref.transform * glm::vec3(fp.uv, 1.0f));
+    return ref.sampler >= 0 ? scene.samplers[size_t(ref.sampler)] : kDefaultSampler;
+}
+
+// KHR_texture_transform: uv' = M (u, v, 1).
+glm::vec2 transformUv(const TextureRef& ref, glm::vec2 uv) {
+    return glm::vec2(ref.transform * glm::vec3(uv, 1.0f));
+}
+
+// glTF/OpenGL LOD: log2 of the longer footprint axis in texels (OpenGL 4.6 §8.14.1). The
+// derivatives transform by the linear part of the texture transform.
+float levelOfDetail(const TextureRef& ref, const Image& image, glm::vec2 duv_dx, glm::vec2 duv_dy) {
     const glm::mat2 lin(glm::vec2(ref.transform[0]), glm::vec2(ref.transform[1]));
     const glm::vec2 size(float(image.levels[0].width), float(image.levels[0].height));
-    const glm::vec2 dx = lin * fp.duv_dx * size, dy = lin * fp.duv_dy * size;
-    // glTF/OpenGL LOD: log2 of the longer footprint axis in texels (OpenGL 4.6 §8.14.1).
+    const glm::vec2 dx = lin * duv_dx * size, dy = lin * duv_dy * size;
     const float rho2 = std::max(glm::dot(dx, dx), glm::dot(dy, dy));
-    const float lod = rho2 > 0.0f ? 0.5f * std::log2(rho2) : -1.0f;
-    return sampleImage(image, sampler, ctx.filter, uv, lod);
+    return rho2 > 0.0f ? 0.5f * std::log2(rho2) : -1.0f;
+}
+
+glm::vec4 sampleRef(const ShadeContext& ctx, const TextureRef& ref, const UvFootprint& fp) {
+    const Image& image = ctx.scene->images[size_t(ref.image)];
+    return sampleImage(image, samplerOf(*ctx.scene, ref), ctx.filter, transformUv(ref, fp.uv),
+                       levelOfDetail(ref, image, fp.duv_dx, fp.duv_dy));
+}
+
+bool fitsTextureKernel(const MipLevel& level) {
+    return level.width <= kTextureKernelMaxSide && level.height <= kTextureKernelMaxSide &&
+           uint64_t(level.width) * level.height <= kTextureKernelMaxTexels;
+}
+
+TextureLevel kernelLevel(const MipLevel& level) {
+    return {reinterpret_cast<const TexelWord*>(level.rgba8.data()), int32_t(level.width),
+            int32_t(level.height)};
 }
 
 } // namespace
 
 TextureRoles sampledTextureRoles(ShadingMode) {
-    // baseColor() and emissiveColor() are the only texture reads, and every mode makes them
-    // (lighting takes metallic and roughness from the material's factors alone).
+    // The base colour and emissive textures are the only texture reads (sampleQuadPair,
+    // emissiveColor), and every mode makes them (lighting takes metallic and roughness from the
+    // material's factors alone).
     return TextureRoles{} | TextureRole::BaseColor | TextureRole::Emissive;
 }
 
-glm::vec4 baseColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
-                    glm::vec4 vertex_color) {
-    glm::vec4 c = m.base_color_factor * vertex_color;
-    if (m.base_color_texture.image >= 0)
-        c *= sampleRef(ctx, m.base_color_texture, uv);
-    return c;
+void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& in,
+                    uint32_t lane_mask, float rgba[4][kTextureLanes]) {
+    const Image& image = ctx.scene->images[size_t(ref.image)];
+    const Sampler& sampler = samplerOf(*ctx.scene, ref);
+    const float lod[2] = {levelOfDetail(ref, image, in.duv_dx[0], in.duv_dy[0]),
+                          levelOfDetail(ref, image, in.duv_dx[1], in.duv_dy[1])};
+    TextureLanes lanes;
+    for (int l = 0; l < kTextureLanes; ++l) {
+        const glm::vec2 uv = transformUv(ref, in.uv[l]);
+        lanes.u[l] = uv.x, lanes.v[l] = uv.y;
+    }
+    // One by one when at most kFewLanes lanes are asked for (a kernel call costs about as much as
+    // three one-fragment lookups; callgrind on ToyCar) or the image is beyond the kernel's
+    // integers.
+    constexpr int kFewLanes = 2;
+    if (__builtin_popcount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
+        for (int l = 0; l < kTextureLanes; ++l) {
+            if (!(lane_mask & (1u << l)))
+                continue;
+            const glm::vec4 c =
+                sampleImage(image, sampler, ctx.filter, {lanes.u[l], lanes.v[l]}, lod[l / 4]);
+            for (int k = 0; k < 4; ++k)
+                rgba[k][l] = c[k];
+        }
+        return;
+    }
+    const LevelSelection sel[2] = {selectLevels(image, sampler, ctx.filter, lod[0]),
+                                   selectLevels(image, sampler, ctx.filter, lod[1])};
+    for (int l = 0; l < kTextureLanes; ++l)
+        lanes.weight[l] = sel[l / 4].weight;
+    // Both quads in one call when they read the same levels the same way (the usual case);
+    // otherwise one call per quad, each keeping its own four lanes.
+    const bool shared = sel[0].level0 == sel[1].level0 && sel[0].level1 == sel[1].level1 &&
+                        sel[0].filter == sel[1].filter && sel[0].mix_levels == sel[1].mix_levels;
+    for (int q = 0; q < (shared ? 1 : 2); ++q) {
+        TextureQuery query;
+        query.level[0] = kernelLevel(image.levels[sel[q].level0]);
+        query.level[1] = kernelLevel(image.levels[sel[q].level1]);
+        query.srgb_lut = image.srgb ? srgbDecodeTable() : nullptr;
+        query.wrap_s = sampler.wrap_s;
+        query.wrap_t = sampler.wrap_t;
+        query.nearest = sel[q].filter == Filter::Nearest;
+        query.mix_levels = sel[q].mix_levels;
+        ctx.texture_kernel(query, lanes);
+        const int first = shared ? 0 : 4 * q, last = shared ? kTextureLanes : 4 * q + 4;
+        for (int k = 0; k < 4; ++k)
+            for (int l = first; l < last; ++l)
+                rgba[k][l] = lanes.rgba[k][l];
+    }
 }
 
 bool isUnlit(const ShadeContext& ctx, const Material& m) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "light_kernel.h"
+#include "texture_kernel.h"
 
 #include <raster/layered_target.h>
 #include <raster/renderer.h>
@@ -25,6 +26,7 @@ struct ShadeContext {
     const PreparedLight* lights = nullptr; // prepareLights(): the scene's or the default light
     uint32_t light_count = 0;
     LightKernel light_kernel = &lightKernelScalar;
+    TextureKernel texture_kernel = &textureKernelScalar;
 };
 
 // Texture coordinates and their screen derivatives (from the 2x2 quad) at one fragment.
@@ -34,9 +36,20 @@ struct UvFootprint {
     glm::vec2 duv_dy{0.0f};
 };
 
-// Base colour and alpha: factor x vertex colour x base colour texture.
-glm::vec4 baseColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
-                    glm::vec4 vertex_color);
+// Texture coordinates of the 8 lanes of two 2x2 quads (quad_kernel.h's lane order: lanes
+// 4q..4q+3 are quad q) and each quad's screen derivatives.
+struct QuadPairUv {
+    glm::vec2 uv[kTextureLanes];
+    glm::vec2 duv_dx[2], duv_dy[2];
+};
+
+// `ref`'s texture (texture transform, level of detail, sampler) at the lanes of a quad pair set
+// in `lanes` (other lanes' rgba may be left unset): linear RGBA per lane, the same bits as a
+// lookup of that one fragment. One level of detail per quad, as GPUs compute it from the quad's
+// derivatives. The lanes are filtered together by the texture kernel, or one by one when only
+// a few are asked for (the kernel's cost does not depend on how many lanes are used).
+void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
+                    uint32_t lanes, float rgba[4][kTextureLanes]);
 
 // Emissive radiance: factor x emissive texture.
 glm::vec3 emissiveColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv);

@@ -141,10 +141,8 @@ void buildMipChain(Image& image) {
     }
 }
 
-glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride filter,
-                      glm::vec2 uv, float lod) {
-    if (image.levels.empty())
-        return glm::vec4(1.0f);
+LevelSelection selectLevels(const Image& image, const Sampler& sampler, FilterOverride filter,
+                            float lod) {
     Filter mag = sampler.mag, min = sampler.min;
     MipFilter mip = sampler.mip;
     switch (filter) {
@@ -160,17 +158,39 @@ glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride
         mag = min = Filter::Linear, mip = MipFilter::Linear;
         break;
     }
-    if (!(lod > 0.0f) || mip == MipFilter::None)
-        return sampleLevel(image, image.levels[0], sampler, lod > 0.0f ? min : mag, uv);
+    LevelSelection s;
+    if (!(lod > 0.0f) || mip == MipFilter::None) {
+        s.filter = lod > 0.0f ? min : mag;
+        return s;
+    }
+    s.filter = min;
     const float max_level = float(image.levels.size() - 1);
     const float l = std::min(lod, max_level);
-    if (mip == MipFilter::Nearest)
-        return sampleLevel(image, image.levels[size_t(std::floor(l + 0.5f))], sampler, min, uv);
-    const size_t l0 = size_t(std::floor(l));
-    const size_t l1 = std::min(l0 + 1, image.levels.size() - 1);
-    const glm::vec4 a = sampleLevel(image, image.levels[l0], sampler, min, uv);
-    const glm::vec4 b = sampleLevel(image, image.levels[l1], sampler, min, uv);
-    return glm::mix(a, b, l - float(l0));
+    if (mip == MipFilter::Nearest) {
+        s.level0 = uint32_t(std::floor(l + 0.5f));
+        return s;
+    }
+    s.level0 = uint32_t(std::floor(l));
+    s.level1 = std::min(s.level0 + 1, uint32_t(image.levels.size() - 1));
+    s.mix_levels = true;
+    s.weight = l - float(s.level0);
+    return s;
+}
+
+const float* srgbDecodeTable() {
+    return srgbTable().data();
+}
+
+glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride filter,
+                      glm::vec2 uv, float lod) {
+    if (image.levels.empty())
+        return glm::vec4(1.0f);
+    const LevelSelection s = selectLevels(image, sampler, filter, lod);
+    const glm::vec4 a = sampleLevel(image, image.levels[s.level0], sampler, s.filter, uv);
+    if (!s.mix_levels)
+        return a;
+    const glm::vec4 b = sampleLevel(image, image.levels[s.level1], sampler, s.filter, uv);
+    return glm::mix(a, b, s.weight);
 }
 
 } // namespace raster

@@ -12,6 +12,8 @@ namespace raster {
 
 namespace {
 
+static_assert(kQuadLanes == kTextureLanes, "the texture kernel samples a quad pair's lanes");
+
 constexpr int32_t kBlockSize = 8; // hierarchical test: tile -> 8x8 block -> 2x2 quad -> pixel
 
 int64_t centre(int64_t i) {
@@ -52,10 +54,13 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         in.z[k] = t.z[k];
     }
     in.inv_area2 = tr.inv_area2;
-    in.valid = 0;
-    for (int l = 0; l < kQuadLanes; ++l) {
-        const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
-        in.valid |= uint32_t(x < int32_t(ctx.grid.width) && y < int32_t(ctx.grid.height)) << l;
+    in.valid = 0xffu;
+    if (qx + 3 >= int32_t(ctx.grid.width) || qy + 1 >= int32_t(ctx.grid.height)) {
+        in.valid = 0; // on the right or bottom border of the viewport
+        for (int l = 0; l < kQuadLanes; ++l) {
+            const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
+            in.valid |= uint32_t(x < int32_t(ctx.grid.width) && y < int32_t(ctx.grid.height)) << l;
+        }
     }
     QuadOutput q;
     ctx.kernel(in, q);
@@ -64,50 +69,70 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
 
     const Material& m = *tr.material;
     const bool textured = m.base_color_texture.image >= 0 || m.emissive_texture.image >= 0;
-    UvFootprint lane_uv[kQuadLanes];
+    QuadPairUv pair_uv{};
     if (textured) {
         // Every lane is interpolated (helper pixels included) so each quad has coarse
         // derivatives, one pair per quad (as GPUs' ddx/ddy).
-        glm::vec2 uv[kQuadLanes];
         for (int l = 0; l < kQuadLanes; ++l)
-            uv[l] = interpolateUv(tr, q, l);
-        for (int l = 0; l < kQuadLanes; ++l) {
-            const int base = l & ~3;
-            lane_uv[l] = {uv[l], uv[base + 1] - uv[base], uv[base + 2] - uv[base]};
+            pair_uv.uv[l] = interpolateUv(tr, q, l);
+        for (int quad = 0; quad < 2; ++quad) {
+            const glm::vec2* uv = &pair_uv.uv[4 * quad];
+            pair_uv.duv_dx[quad] = uv[1] - uv[0];
+            pair_uv.duv_dy[quad] = uv[2] - uv[0];
         }
     }
 
-    // Per covered lane: early depth test, base colour, alpha test. Lanes are distinct pixels,
-    // so testing them all before any is written is the same as one at a time.
-    Fragment frags[kQuadLanes];
-    int lane_of[kQuadLanes];
-    glm::vec3 normals[kQuadLanes];
-    int active = 0;
-    LightLanes light;
+    // Early depth test of every covered lane: legal because this tile's owner is the only
+    // writer of the pixel. Lanes are distinct pixels and nothing is written before all are
+    // tested, so testing them all first is the same as one at a time.
+    uint32_t tested = 0;
     for (int l = 0; l < kQuadLanes; ++l) {
         if (!(q.mask & (1u << l)))
             continue;
         ++counters.covered;
         const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
         const size_t idx = size_t(y) * ctx.grid.width + size_t(x);
-        Fragment& frag = frags[active];
-        frag.z = q.z[l];
-        frag.distance = q.distance[l];
-        // Early depth test: legal because this tile's owner is the only writer of the pixel.
-        if (!sink.test(idx, frag.z, frag.distance)) {
+        if (sink.test(idx, q.z[l], q.distance[l]))
+            tested |= 1u << l;
+        else
             ++counters.rejected;
+    }
+    if (tested == 0)
+        return;
+
+    // The textures at the lanes that passed, together (the texture kernel).
+    const bool base_textured = m.base_color_texture.image >= 0;
+    const bool emissive_textured =
+        m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
+    float base_texel[4][kTextureLanes], emissive_texel[4][kTextureLanes];
+    if (base_textured)
+        sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, tested, base_texel);
+    if (emissive_textured)
+        sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, tested, emissive_texel);
+
+    // Per lane that passed: base colour (factor x vertex colour x texture), alpha test.
+    const bool blend = m.alpha_mode == AlphaMode::Blend;
+    float alpha[kQuadLanes];
+    int lane_of[kQuadLanes];
+    glm::vec3 normals[kQuadLanes];
+    int active = 0;
+    LightLanes light;
+    for (int l = 0; l < kQuadLanes; ++l) {
+        if (!(tested & (1u << l)))
             continue;
-        }
         const float b[3] = {q.persp[0][l], q.persp[1][l], q.persp[2][l]};
         const glm::vec4 vcolor =
             tr.has_colors ? b[0] * tr.v[0]->color + b[1] * tr.v[1]->color + b[2] * tr.v[2]->color
                           : glm::vec4(1.0f);
-        const glm::vec4 base = baseColor(ctx.shade, m, lane_uv[l], vcolor);
+        glm::vec4 base = m.base_color_factor * vcolor;
+        if (base_textured)
+            base *=
+                glm::vec4(base_texel[0][l], base_texel[1][l], base_texel[2][l], base_texel[3][l]);
         if (m.alpha_mode == AlphaMode::Mask && !(base.a >= m.alpha_cutoff))
             continue;
         // A BLEND fragment of opacity 0 changes nothing: dropped like a masked one, so it takes
         // no fragment-list slot and no transparent depth.
-        if (m.alpha_mode == AlphaMode::Blend && !(base.a > 0.0f))
+        if (blend && !(base.a > 0.0f))
             continue;
         ++counters.passed;
         const glm::vec3 world =
@@ -118,16 +143,16 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
             if (!t.front_facing)
                 normal = -normal; // glTF: back faces of double-sided materials flip the normal
         }
-        const glm::vec3 emissive = emissiveColor(ctx.shade, m, lane_uv[l]);
+        glm::vec3 emissive = m.emissive_factor;
+        if (emissive_textured)
+            emissive *= glm::vec3(emissive_texel[0][l], emissive_texel[1][l], emissive_texel[2][l]);
         for (int c = 0; c < 3; ++c) {
             light.albedo[c][active] = base[c];
             light.emissive[c][active] = emissive[c];
             light.world[c][active] = world[c];
             light.normal[c][active] = normal[c];
         }
-        frag.blend = m.alpha_mode == AlphaMode::Blend;
-        frag.color.a = frag.blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f;
-        frag.primitive_id = t.primitive_id;
+        alpha[active] = blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f;
         normals[active] = normal;
         lane_of[active++] = l;
     }
@@ -144,12 +169,18 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
     for (int i = 0; i < active; ++i) {
         const int l = lane_of[i];
         const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
-        Fragment& frag = frags[i];
+        Fragment frag;
+        frag.z = q.z[l];
+        frag.distance = q.distance[l];
+        frag.blend = blend;
+        frag.color.a = alpha[i];
+        frag.primitive_id = t.primitive_id;
         for (int c = 0; c < 3; ++c)
             frag.color[c] = unlit ? light.albedo[c][i] + light.emissive[c][i] : light.rgb[c][i];
         if (sink.wants_gbuffer) {
             const glm::vec4 base(light.albedo[0][i], light.albedo[1][i], light.albedo[2][i], 1.0f);
-            frag.g = surfaceSample(ctx.shade, m, lane_uv[l], base, normals[i]);
+            const UvFootprint uv{pair_uv.uv[l], pair_uv.duv_dx[l / 4], pair_uv.duv_dy[l / 4]};
+            frag.g = surfaceSample(ctx.shade, m, uv, base, normals[i]);
         }
         sink.write(size_t(y) * ctx.grid.width + size_t(x), frag);
     }

@@ -76,6 +76,20 @@ enum class FilterOverride : uint8_t { Sampler, Nearest, Bilinear, Trilinear };
 glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride filter,
                       glm::vec2 uv, float lod);
 
+// The levels and filter sampleImage uses at `lod` (image.levels must not be empty): level0
+// filtered with `filter`, and when mix_levels, mixed with level1 by `weight`.
+struct LevelSelection {
+    uint32_t level0 = 0, level1 = 0;
+    Filter filter = Filter::Linear;
+    bool mix_levels = false;
+    float weight = 0.0f;
+};
+LevelSelection selectLevels(const Image& image, const Sampler& sampler, FilterOverride filter,
+                            float lod);
+
+// The 256-entry table decoding 8-bit sRGB to linear (srgbToLinear(i / 255)).
+const float* srgbDecodeTable();
+
 // sRGB transfer function, exact (IEC 61966-2-1).
 float srgbToLinear(float v);
 float linearToSrgb(float v);

@@ -1,0 +1,114 @@
+// Body of the texture kernel (texture_kernel.h); included by texture_kernel.cpp and
+// texture_kernel_avx2.cpp. Lane loops over fixed-size arrays doing, per lane, the operations of
+// texture.cpp's sampleLevel in the same order, so the results are its bits; branches only on
+// what the lanes share. No calls to inline library templates (see quad_kernel.inl).
+#ifndef FOCAL_TEXTURE_KERNEL_NAME
+#error "define FOCAL_TEXTURE_KERNEL_NAME before including texture_kernel.inl"
+#endif
+
+namespace {
+
+constexpr int kLanes = kTextureLanes;
+
+// texture.cpp's texelCoord: u * size - 1/2 in double (exact: a float times an integer below
+// 2^22), 0 for non-finite u, clamped to +-2^30 so the integer part fits int32.
+inline double texelCoordLane(float u, double size) {
+    const double x = __builtin_fabsf(u) <= 3.40282347e38f ? double(u) * size - 0.5 : 0.0;
+    return x < -1073741824.0 ? -1073741824.0 : (1073741824.0 < x ? 1073741824.0 : x);
+}
+
+// texture.cpp's wrapIndex of i and of i + 1, for |i| <= 2^30 and 0 < n <= kTextureKernelMaxSide.
+// The period's multiple is floor(i / period) in double, exact: the quotient's rounding error
+// (< 2^-22) is smaller than its distance (>= 1/period) from the next integer above.
+inline void wrapLanes(const int32_t* i, int32_t n, Wrap mode, int32_t* w0, int32_t* w1) {
+    if (mode == Wrap::ClampToEdge) {
+        for (int l = 0; l < kLanes; ++l) {
+            const int32_t a = i[l], b = i[l] + 1;
+            w0[l] = a < 0 ? 0 : (a > n - 1 ? n - 1 : a);
+            w1[l] = b < 0 ? 0 : (b > n - 1 ? n - 1 : b);
+        }
+        return;
+    }
+    const int32_t period = mode == Wrap::Repeat ? n : 2 * n;
+    const double period_d = double(period);
+    for (int l = 0; l < kLanes; ++l) {
+        const int32_t m = i[l] - period * int32_t(__builtin_floor(double(i[l]) / period_d));
+        w0[l] = m;
+        w1[l] = m + 1 == period ? 0 : m + 1;
+    }
+    if (mode == Wrap::MirroredRepeat)
+        for (int l = 0; l < kLanes; ++l) {
+            w0[l] = w0[l] < n ? w0[l] : period - 1 - w0[l];
+            w1[l] = w1[l] < n ? w1[l] : period - 1 - w1[l];
+        }
+}
+
+// Texel (x, y) of every lane as linear RGBA (texture.cpp's fetch). Indices are int32 so the
+// vectorizer can use gathers.
+inline void fetchLanes(const TextureLevel& level, const float* lut, const int32_t* x,
+                       const int32_t* y, float (*rgba)[kLanes]) {
+    alignas(32) uint32_t t[kLanes];
+    for (int l = 0; l < kLanes; ++l)
+        t[l] = level.texels[y[l] * level.width + x[l]];
+    if (lut) {
+        for (int l = 0; l < kLanes; ++l) {
+            rgba[0][l] = lut[int32_t(t[l] & 0xffu)];
+            rgba[1][l] = lut[int32_t((t[l] >> 8) & 0xffu)];
+            rgba[2][l] = lut[int32_t((t[l] >> 16) & 0xffu)];
+            rgba[3][l] = float(int32_t(t[l] >> 24)) * (1.0f / 255.0f);
+        }
+        return;
+    }
+    for (int c = 0; c < 4; ++c)
+        for (int l = 0; l < kLanes; ++l)
+            rgba[c][l] = float(int32_t((t[l] >> (8 * c)) & 0xffu)) * (1.0f / 255.0f);
+}
+
+// One level, nearest or bilinear, at every lane (texture.cpp's sampleLevel).
+inline void sampleLevelLanes(const TextureQuery& q, const TextureLevel& level, const float* u,
+                             const float* v, float (*rgba)[kLanes]) {
+    const double w = double(level.width), h = double(level.height);
+    alignas(32) int32_t ix[kLanes], iy[kLanes];
+    alignas(32) float ax[kLanes], ay[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+        const double x = texelCoordLane(u[l], w), y = texelCoordLane(v[l], h);
+        const double fx = __builtin_floor(q.nearest ? x + 0.5 : x);
+        const double fy = __builtin_floor(q.nearest ? y + 0.5 : y);
+        ax[l] = float(x - fx);
+        ay[l] = float(y - fy);
+        ix[l] = int32_t(fx);
+        iy[l] = int32_t(fy);
+    }
+    alignas(32) int32_t x0[kLanes], x1[kLanes], y0[kLanes], y1[kLanes];
+    wrapLanes(ix, level.width, q.wrap_s, x0, x1);
+    wrapLanes(iy, level.height, q.wrap_t, y0, y1);
+    if (q.nearest) {
+        fetchLanes(level, q.srgb_lut, x0, y0, rgba);
+        return;
+    }
+    alignas(32) float c00[4][kLanes], c10[4][kLanes], c01[4][kLanes], c11[4][kLanes];
+    fetchLanes(level, q.srgb_lut, x0, y0, c00);
+    fetchLanes(level, q.srgb_lut, x1, y0, c10);
+    fetchLanes(level, q.srgb_lut, x0, y1, c01);
+    fetchLanes(level, q.srgb_lut, x1, y1, c11);
+    // glm::mix(a, b, t) = a * (1 - t) + b * t: across, then down.
+    for (int c = 0; c < 4; ++c)
+        for (int l = 0; l < kLanes; ++l) {
+            const float top = c00[c][l] * (1.0f - ax[l]) + c10[c][l] * ax[l];
+            const float bottom = c01[c][l] * (1.0f - ax[l]) + c11[c][l] * ax[l];
+            rgba[c][l] = top * (1.0f - ay[l]) + bottom * ay[l];
+        }
+}
+
+} // namespace
+
+void FOCAL_TEXTURE_KERNEL_NAME(const TextureQuery& query, TextureLanes& io) {
+    sampleLevelLanes(query, query.level[0], io.u, io.v, io.rgba);
+    if (!query.mix_levels)
+        return;
+    alignas(32) float upper[4][kLanes];
+    sampleLevelLanes(query, query.level[1], io.u, io.v, upper);
+    for (int c = 0; c < 4; ++c)
+        for (int l = 0; l < kLanes; ++l)
+            io.rgba[c][l] = io.rgba[c][l] * (1.0f - io.weight[l]) + upper[c][l] * io.weight[l];
+}
