@@ -1,4 +1,5 @@
 #include <dof/multiview.h>
+#include <raster/simd.h>
 #include <raster/surface_shading.h>
 
 #include <glm/geometric.hpp>
@@ -1148,7 +1149,7 @@ traceTileAvx2(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t 
 
 TraceTileFn traceTileFor(bool simd) {
 #ifdef FOCAL_MULTIVIEW_AVX2
-    if (simd && __builtin_cpu_supports("avx2"))
+    if (raster::useAvx2(simd))
         return traceTileAvx2;
 #endif
     (void)simd;

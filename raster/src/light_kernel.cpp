@@ -1,5 +1,7 @@
 #include "light_kernel.h"
 
+#include <raster/simd.h>
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -18,13 +20,7 @@ LightKernel lightKernelAvx2() {
 #endif
 
 LightKernel selectLightKernel(bool simd) {
-#if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
-    if (simd && __builtin_cpu_supports("avx2"))
-        return lightKernelAvx2();
-#else
-    (void)simd;
-#endif
-    return &lightKernelScalar;
+    return useAvx2(simd) ? lightKernelAvx2() : &lightKernelScalar;
 }
 
 std::vector<PreparedLight> prepareLights(const Scene& scene, glm::vec3 default_direction) {

@@ -1,5 +1,7 @@
 #include "quad_kernel.h"
 
+#include <raster/simd.h>
+
 namespace raster {
 
 #define FOCAL_QUAD_KERNEL_NAME quadKernelScalar
@@ -13,13 +15,7 @@ QuadKernel quadKernelAvx2() {
 #endif
 
 QuadKernel selectQuadKernel(bool simd) {
-#if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
-    if (simd && __builtin_cpu_supports("avx2"))
-        return quadKernelAvx2();
-#else
-    (void)simd;
-#endif
-    return &quadKernelScalar;
+    return useAvx2(simd) ? quadKernelAvx2() : &quadKernelScalar;
 }
 
 } // namespace raster

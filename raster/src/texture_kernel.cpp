@@ -1,5 +1,7 @@
 #include "texture_kernel.h"
 
+#include <raster/simd.h>
+
 namespace raster {
 
 #define FOCAL_TEXTURE_KERNEL_NAME textureKernelScalar
@@ -13,13 +15,7 @@ TextureKernel textureKernelAvx2() {
 #endif
 
 TextureKernel selectTextureKernel(bool simd) {
-#if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
-    if (simd && __builtin_cpu_supports("avx2"))
-        return textureKernelAvx2();
-#else
-    (void)simd;
-#endif
-    return &textureKernelScalar;
+    return useAvx2(simd) ? textureKernelAvx2() : &textureKernelScalar;
 }
 
 } // namespace raster
