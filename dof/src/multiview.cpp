@@ -1121,20 +1121,16 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
 // Without FMA the AVX2 copy computes the same IEEE operations in the same order (the build
 // forbids contraction and reassociation), so the bytes are the same; what differs is the
 // instructions chosen (a floor is one `vroundss` instead of a dozen SSE2 instructions, selects
-// are blends). The scalar copy is the reference: ShadingInputs::simd = false (`--no-simd`).
+// are blends). The baseline copy is the reference: ShadingInputs::simd = false (`--no-simd`).
 #if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
 #define FOCAL_MULTIVIEW_AVX2 1
 #endif
-using TraceTileFn = void (*)(const Tracer&, uint32_t, uint32_t, uint32_t, uint32_t,
-                             const uint32_t*, uint32_t, RayState*, PixelLayers*, float*,
-                             TileCounters&);
+using TraceTileFn = decltype(&traceTile);
 
-__attribute__((flatten)) void traceTileBaseline(const Tracer& tr, uint32_t x0, uint32_t x1,
-                                                uint32_t y0, uint32_t y1,
-                                                const uint32_t* tile_layers,
-                                                uint32_t tile_layer_count, RayState* rays,
-                                                PixelLayers* pixel_layers, float* rgba,
-                                                TileCounters& cnt) {
+__attribute__((flatten)) void
+traceTileBaseline(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+                  const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
+                  PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
     traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt);
 }
 

@@ -31,12 +31,6 @@ float levelOfDetail(const TextureRef& ref, const Image& image, glm::vec2 duv_dx,
     return rho2 > 0.0f ? 0.5f * std::log2(rho2) : -1.0f;
 }
 
-glm::vec4 sampleRef(const ShadeContext& ctx, const TextureRef& ref, const UvFootprint& fp) {
-    const Image& image = ctx.scene->images[size_t(ref.image)];
-    return sampleImage(image, samplerOf(*ctx.scene, ref), ctx.filter, transformUv(ref, fp.uv),
-                       levelOfDetail(ref, image, fp.duv_dx, fp.duv_dy));
-}
-
 bool fitsTextureKernel(const MipLevel& level) {
     return level.width <= kTextureKernelMaxSide && level.height <= kTextureKernelMaxSide &&
            uint64_t(level.width) * level.height <= kTextureKernelMaxTexels;
@@ -50,8 +44,8 @@ TextureLevel kernelLevel(const MipLevel& level) {
 } // namespace
 
 TextureRoles sampledTextureRoles(ShadingMode) {
-    // The base colour and emissive textures are the only texture reads (sampleQuadPair,
-    // emissiveColor), and every mode makes them (lighting takes metallic and roughness from the
+    // The base colour and emissive textures are the only texture reads (sampleQuadPair in the
+    // tile raster), and every mode makes them (lighting takes metallic and roughness from the
     // material's factors alone).
     return TextureRoles{} | TextureRole::BaseColor | TextureRole::Emissive;
 }
@@ -111,22 +105,15 @@ bool isUnlit(const ShadeContext& ctx, const Material& m) {
     return ctx.mode == ShadingMode::Unlit || (ctx.mode == ShadingMode::Material && m.unlit);
 }
 
-glm::vec3 emissiveColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv) {
-    glm::vec3 emissive = m.emissive_factor;
-    if (m.emissive_texture.image >= 0 && emissive != glm::vec3(0.0f))
-        emissive *= glm::vec3(sampleRef(ctx, m.emissive_texture, uv));
-    return emissive;
-}
-
-GSample surfaceSample(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
-                      glm::vec4 base, glm::vec3 normal) {
+GSample surfaceSample(const ShadeContext& ctx, const Material& m, glm::vec3 base,
+                      glm::vec3 emissive, glm::vec3 normal) {
     GSample g;
     const float len = glm::length(normal);
     g.normal = len > 0.0f ? normal / len : glm::vec3(0.0f, 0.0f, 1.0f);
-    g.base_color = glm::vec3(base);
+    g.base_color = base;
     g.metallic = m.metallic_factor;
     g.roughness = m.roughness_factor;
-    g.emissive = emissiveColor(ctx, m, uv);
+    g.emissive = emissive;
     g.unlit = isUnlit(ctx, m) ? 1.0f : 0.0f;
     return g;
 }

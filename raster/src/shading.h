@@ -29,13 +29,6 @@ struct ShadeContext {
     TextureKernel texture_kernel = &textureKernelScalar;
 };
 
-// Texture coordinates and their screen derivatives (from the 2x2 quad) at one fragment.
-struct UvFootprint {
-    glm::vec2 uv{0.0f};
-    glm::vec2 duv_dx{0.0f};
-    glm::vec2 duv_dy{0.0f};
-};
-
 // Texture coordinates of the 8 lanes of two 2x2 quads (quad_kernel.h's lane order: lanes
 // 4q..4q+3 are quad q) and each quad's screen derivatives.
 struct QuadPairUv {
@@ -51,16 +44,14 @@ struct QuadPairUv {
 void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
                     uint32_t lanes, float rgba[4][kTextureLanes]);
 
-// Emissive radiance: factor x emissive texture.
-glm::vec3 emissiveColor(const ShadeContext& ctx, const Material& m, const UvFootprint& uv);
-
 // Whether fragments of `m` skip lighting (KHR_materials_unlit or --shading unlit).
 bool isUnlit(const ShadeContext& ctx, const Material& m);
 
 // The surface parameters a G-buffer keeps so a hit can be re-shaded from another view
-// direction (Lee et al. 2009 §5): unit normal, albedo, metallic, roughness, emissive.
-GSample surfaceSample(const ShadeContext& ctx, const Material& m, const UvFootprint& uv,
-                      glm::vec4 base, glm::vec3 normal);
+// direction (Lee et al. 2009 §5): unit normal, albedo, metallic, roughness, emissive. `base` and
+// `emissive` are the fragment's, as the tile raster computed them for its shading.
+GSample surfaceSample(const ShadeContext& ctx, const Material& m, glm::vec3 base,
+                      glm::vec3 emissive, glm::vec3 normal);
 
 // Shades a G-buffer sample at `world` as seen from `eye` (the same lighting kernel as fragments).
 glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world, glm::vec3 eye);

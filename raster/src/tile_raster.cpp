@@ -178,9 +178,10 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
         for (int c = 0; c < 3; ++c)
             frag.color[c] = unlit ? light.albedo[c][i] + light.emissive[c][i] : light.rgb[c][i];
         if (sink.wants_gbuffer) {
-            const glm::vec4 base(light.albedo[0][i], light.albedo[1][i], light.albedo[2][i], 1.0f);
-            const UvFootprint uv{pair_uv.uv[l], pair_uv.duv_dx[l / 4], pair_uv.duv_dy[l / 4]};
-            frag.g = surfaceSample(ctx.shade, m, uv, base, normals[i]);
+            const glm::vec3 base(light.albedo[0][i], light.albedo[1][i], light.albedo[2][i]);
+            const glm::vec3 emissive(light.emissive[0][i], light.emissive[1][i],
+                                     light.emissive[2][i]);
+            frag.g = surfaceSample(ctx.shade, m, base, emissive, normals[i]);
         }
         sink.write(size_t(y) * ctx.grid.width + size_t(x), frag);
     }
