@@ -388,10 +388,26 @@ MipLevel mipLevelFor(const Tracer& tr, float diameter) {
     return {l0, std::min(l0 + 1, top), level - float(l0)};
 }
 
+// Four channels of a texel as one SSE vector (a GCC/clang vector extension, on the baseline
+// target as on AVX2): the lookups' arithmetic is element-wise, so each lane performs the same
+// IEEE operations in the same order as the scalar expression, and the bits do not change.
+using Channels4 = float __attribute__((vector_size(16)));
+inline Channels4 loadChannels4(const float* p) {
+    Channels4 v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+}
+
 // Trilinear lookup of the first C channels of a layer mipmap `mip` with Stride channels per
-// texel (§4.4) at image position (px, py) on the levels `lv`.
+// texel (§4.4) at image position (px, py) on the levels `lv`. Channels 0-3 are weighted as one
+// vector (C = 2 reads four and keeps two: a texel has Stride >= 4 channels); a fifth is scalar.
 template <int C, int Stride = C>
 std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel lv) {
+    static_assert(C <= 5 && Stride >= 4 && Stride >= C);
+    struct Taps {
+        Channels4 v;
+        float e; // channel 4 when C == 5
+    };
     auto bilinear = [&](uint32_t level) {
         const MipView& m = mip[level];
         const int64_t w = m.width, h = m.height;
@@ -418,21 +434,30 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
             r0 = m.data + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * Stride;
             r1 = m.data + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * Stride;
         }
-        std::array<float, C> out;
-        for (int c = 0; c < C; ++c) {
-            const float top_row = r0[x0 + c] * (1.0f - au) + r0[x1 + c] * au;
-            const float bottom = r1[x0 + c] * (1.0f - au) + r1[x1 + c] * au;
-            out[c] = top_row * (1.0f - av) + bottom * av;
+        const float bu = 1.0f - au, bv = 1.0f - av;
+        Taps out;
+        const Channels4 top_row = loadChannels4(r0 + x0) * bu + loadChannels4(r0 + x1) * au;
+        const Channels4 bottom = loadChannels4(r1 + x0) * bu + loadChannels4(r1 + x1) * au;
+        out.v = top_row * bv + bottom * av;
+        out.e = 0.0f;
+        if constexpr (C == 5) {
+            const float top4 = r0[x0 + 4] * bu + r0[x1 + 4] * au;
+            const float bottom4 = r1[x0 + 4] * bu + r1[x1 + 4] * au;
+            out.e = top4 * bv + bottom4 * av;
         }
         return out;
     };
-    std::array<float, C> c0 = bilinear(lv.l0);
-    if (lv.l1 == lv.l0 || lv.f == 0.0f)
-        return c0;
-    const std::array<float, C> c1 = bilinear(lv.l1);
+    Taps c0 = bilinear(lv.l0);
+    if (lv.l1 != lv.l0 && lv.f != 0.0f) {
+        const Taps c1 = bilinear(lv.l1);
+        const float g = 1.0f - lv.f;
+        c0.v = c0.v * g + c1.v * lv.f;
+        c0.e = c0.e * g + c1.e * lv.f;
+    }
+    std::array<float, C> out;
     for (int c = 0; c < C; ++c)
-        c0[c] = c0[c] * (1.0f - lv.f) + c1[c] * lv.f;
-    return c0;
+        out[c] = c < 4 ? c0.v[c] : c0.e;
+    return out;
 }
 
 // Whether sampleMip on `mip` (Stride channels per texel, a non-negative coverage in channel
