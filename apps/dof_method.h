@@ -5,6 +5,8 @@
 
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
+#include <dof/multilayer.h>
+#include <dof/multiview.h>
 #include <raster/camera.h>
 #include <raster/renderer.h>
 #include <raster/scene.h>
@@ -15,12 +17,38 @@
 #include <nlohmann/json.hpp>
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace focal {
+
+// What a method keeps from one run to the next of a render command (`--repeat`, the bench's
+// timed runs): its renderer and its targets and scratch, so that a repeated frame reuses their
+// memory instead of allocating, faulting in and clearing it again. The same bytes as fresh ones
+// (each method overwrites or clears everything it reads). Issue 20's FrameRenderer is to own
+// these in the library.
+class MethodBuffers {
+public:
+    // The renderer over `pool` (made again if the pool changes).
+    raster::Renderer& renderer(raster::TaskPool& pool) {
+        if (!renderer_ || pool_ != &pool) {
+            renderer_ = std::make_unique<raster::Renderer>(pool);
+            pool_ = &pool;
+        }
+        return *renderer_;
+    }
+    raster::Frame pinhole;        // the pinhole frame through the lens centre
+    raster::LayeredTarget layers; // multiview's layered target (§4.2 of Lee et al. 2009)
+    dof::MultiviewScratch multiview;
+    dof::Multilayer multilayer;
+
+private:
+    std::unique_ptr<raster::Renderer> renderer_;
+    const raster::TaskPool* pool_ = nullptr;
+};
 
 // What every method gets: the scene, the pinhole view through the lens centre, the thin lens
 // (from --aperture-radius/--fstop/--focus-distance/...), the lens samples shared with accum
@@ -41,6 +69,8 @@ struct MethodInput {
     // The aperture the lens samples were drawn on (--aperture-shape ...), for methods that draw
     // their own per-pixel sample sets (e.g. multiview's 2N Halton jitter).
     const dof::ApertureShape* aperture = nullptr;
+    // Kept between runs by the caller (MethodBuffers).
+    MethodBuffers* buffers = nullptr;
 };
 
 // What it returns for one run.

@@ -39,9 +39,11 @@ raster::Status runGather(const GatherArgs& args, const MethodInput& in, MethodOu
     raster::View pinhole = in.view;
     pinhole.lens_offset = glm::vec2(0.0f);
     pinhole.pixel_shift = glm::vec2(0.0f);
-    raster::Renderer renderer(in.pool);
-    raster::Frame frame;
-    if (raster::Status s = renderer.render(in.scene, pinhole, in.options, frame); !s.ok())
+    MethodBuffers local;
+    MethodBuffers& buffers = in.buffers ? *in.buffers : local;
+    raster::Frame& frame = buffers.pinhole;
+    if (raster::Status s = buffers.renderer(in.pool).render(in.scene, pinhole, in.options, frame);
+        !s.ok())
         return s;
     const double ms_render =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -103,14 +103,16 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     raster::View pinhole = in.view;
     pinhole.lens_offset = glm::vec2(0.0f);
     pinhole.pixel_shift = glm::vec2(0.0f);
-    raster::Renderer renderer(in.pool);
+    MethodBuffers local;
+    MethodBuffers& buffers = in.buffers ? *in.buffers : local;
+    raster::Renderer& renderer = buffers.renderer(in.pool);
     raster::FrameStats raster_stats;
     const dof::CollectFn collect = [&](const raster::FragmentListDesc& desc,
                                        raster::FragmentLists& lists) {
         return renderer.renderFragmentLists(in.scene, pinhole, in.options, desc, lists,
                                             &raster_stats);
     };
-    dof::Multilayer multilayer;
+    dof::Multilayer& multilayer = buffers.multilayer;
     dof::MultilayerImage image;
     dof::MultilayerStats st;
     if (raster::Status s = multilayer.render(pinhole, in.lens, in.scene.background, settings,

@@ -330,9 +330,11 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
         s.sequence_2n = &*seq;
     }
 
-    raster::Renderer renderer(in.pool);
-    raster::Frame pinhole;
-    raster::LayeredTarget layers;
+    MethodBuffers local;
+    MethodBuffers& buffers = in.buffers ? *in.buffers : local;
+    raster::Renderer& renderer = buffers.renderer(in.pool);
+    raster::Frame& pinhole = buffers.pinhole;
+    raster::LayeredTarget& layers = buffers.layers;
     const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
         return renderer.render(in.scene, v, in.options, f);
     };
@@ -364,7 +366,7 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     shading.simd = in.options.simd;
     raster::Result<dof::MultiviewStats> r =
         dof::renderMultiview(in.view, in.lens, in.lens_samples, s, shading, in.scene.background,
-                             pin, lay, in.pool, out.rgba, &pinhole, &layers);
+                             pin, lay, in.pool, out.rgba, &pinhole, &layers, &buffers.multiview);
     if (!r.ok())
         return r.status();
     const dof::MultiviewStats& st = *r;

@@ -638,6 +638,7 @@ int runRender(const RenderArgs& args) {
     }
 
     MethodOutput method_out;
+    MethodBuffers method_buffers; // reused by every run (--repeat)
     std::vector<std::pair<std::string, std::vector<double>>> method_stage_ms;
 
     nlohmann::json runs = nlohmann::json::array();
@@ -659,8 +660,8 @@ int runRender(const RenderArgs& args) {
                 return fail(r.status().message());
             accum_stats = *r;
         } else if (table_method) {
-            MethodInput in{*scene,  *view,        choice.lens,  *lens_samples,   pool,
-                           options, target_color, target_depth, &*aperture_shape};
+            MethodInput in{*scene,  *view,        choice.lens,  *lens_samples,    pool,
+                           options, target_color, target_depth, &*aperture_shape, &method_buffers};
             method_out = MethodOutput{};
             if (Status s = table_method->run(in, method_out); !s.ok())
                 return fail(s.message());

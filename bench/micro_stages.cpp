@@ -183,8 +183,10 @@ void methodBench(benchmark::State& state, const std::string& method) {
     FOCAL_CHECK(samples.ok());
     raster::RenderOptions options;
     std::map<std::string, double> stage_sum;
+    focal::MethodBuffers buffers; // kept between iterations, as `focal render --repeat` keeps it
     for (auto _ : state) {
-        focal::MethodInput in{s.scene, s.view, s.lens, *samples, pool, options, {}, {}};
+        focal::MethodInput in{s.scene, s.view, s.lens, *samples, pool,
+                              options, {},     {},     nullptr,  &buffers};
         focal::MethodOutput out;
         FOCAL_CHECK(entry->run(in, out).ok());
         for (const auto& [stage, ms] : out.stage_ms)

@@ -1443,7 +1443,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     const bool transparency = layers.hasTransparency();
     scratch.depth.resize(m);
     scratch.transparent_depth.resize(transparency ? m : 0);
-    scratch.nbuffers.assign(m, NBuffer{});
+    // Buffers kept from the caller's previous frame are resized in place, not reallocated: every
+    // slot read below is rewritten, and a layer that builds nothing is cleared.
+    scratch.nbuffers.resize(m);
     std::vector<float> content_min(m, INFINITY), content_max(m, -INFINITY);
     std::vector<uint8_t> transparent_content(m, 0);
     pool.parallelFor(m, [&](uint32_t l, uint32_t) {
@@ -1522,10 +1524,14 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     stats.ms_decomposition = msSince(t0); // the copy belongs to the decomposition's cost
 
     t0 = Clock::now();
+    if (!settings.culling)
+        scratch.nbuffers.assign(m, NBuffer{});
     if (settings.culling) {
         pool.parallelFor(m, [&](uint32_t l, uint32_t) {
-            if (tr.segs[l].empty)
+            if (tr.segs[l].empty) {
+                scratch.nbuffers[l] = NBuffer{};
                 return;
+            }
             // Window side 2 * reach + 2 texels for a pixel; the tile query uses more (it falls
             // back to a conservative tiling when the levels run out).
             const float side = 2.0f * (tr.segs[l].reach_px + tr.segs[l].cone_px) + 2.0f +
@@ -1550,9 +1556,16 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     stats.ms_nbuffer = msSince(t0);
 
     t0 = Clock::now();
-    scratch.mips.assign(m, {});
-    scratch.transparent_mips.assign(transparency ? m : 0, {});
-    scratch.owned_mips.assign(settings.cone && settings.cone_misses ? m : 0, {});
+    // Per layer, the levels built below (cleared for the layers that build none).
+    auto keepLayers = [&](std::vector<std::vector<std::vector<float>>>& mips, bool used) {
+        mips.resize(used ? m : 0);
+        for (uint32_t l = 0; l < mips.size(); ++l)
+            if (!settings.cone || tr.segs[l].empty)
+                mips[l].clear();
+    };
+    keepLayers(scratch.mips, true);
+    keepLayers(scratch.transparent_mips, transparency);
+    keepLayers(scratch.owned_mips, settings.cone && settings.cone_misses);
     scratch.mip_width.clear();
     scratch.mip_height.clear();
     if (settings.cone) {
@@ -1772,7 +1785,8 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
                 const MultiviewSettings& settings, const ShadingInputs& shading,
                 glm::vec3 background, const PinholeFn& render_pinhole,
                 const LayersFn& render_layers, raster::TaskPool& pool, std::vector<float>& rgba,
-                raster::Frame* pinhole_out, raster::LayeredTarget* layers_out) {
+                raster::Frame* pinhole_out, raster::LayeredTarget* layers_out,
+                MultiviewScratch* scratch_io) {
     if (Status st = validate(settings, samples.size()); !st.ok())
         return st;
     if (Status st = validate(lens, view); !st.ok())
@@ -1825,7 +1839,8 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     if (Status st = render_layers(view, *desc, layers); !st.ok())
         return st;
     const double ms_layers = msSince(t0);
-    MultiviewScratch scratch;
+    MultiviewScratch local_scratch;
+    MultiviewScratch& scratch = scratch_io ? *scratch_io : local_scratch;
     raster::Result<MultiviewStats> r =
         synthesizeMultiview(view, lens, samples, pinhole, layers, spacing, settings, shading,
                             background, pool, scratch, rgba);

@@ -259,13 +259,16 @@ using LayersFn = std::function<raster::Status(const raster::View&, const raster:
 
 // The whole method: pinhole render (visible depth range, §4.1), layered render (§4.2), then
 // synthesizeMultiview. When the lens cannot change the image (MultiviewStats::skipped) the output
-// is the pinhole frame. `rgba` as above.
+// is the pinhole frame. `rgba` as above. `pinhole_out`, `layers_out` and `scratch` (optional)
+// are the caller's: kept from one frame to the next, their buffers are resized in place rather
+// than allocated again (the same bytes as fresh ones).
 raster::Result<MultiviewStats>
 renderMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
                 const MultiviewSettings& settings, const ShadingInputs& shading,
                 glm::vec3 background, const PinholeFn& render_pinhole,
                 const LayersFn& render_layers, raster::TaskPool& pool, std::vector<float>& rgba,
-                raster::Frame* pinhole_out = nullptr, raster::LayeredTarget* layers_out = nullptr);
+                raster::Frame* pinhole_out = nullptr, raster::LayeredTarget* layers_out = nullptr,
+                MultiviewScratch* scratch = nullptr);
 
 // Validates settings alone (ranges of every option, messages naming them).
 raster::Status validate(const MultiviewSettings& settings, uint32_t sample_count);

@@ -687,6 +687,73 @@ TEST(Multiview, SameBytesForEveryThreadCount) {
     }
 }
 
+// The caller's buffers kept from frame to frame (renderMultiview's pinhole_out, layers_out and
+// scratch, as `focal render --repeat` keeps them) give the bytes of fresh ones, whatever the
+// previous frame was: another scene and size, more or fewer layers, transparent planes or none,
+// culling, cones and missed cones on or off.
+TEST(Multiview, BuffersKeptBetweenFramesGiveTheSameBytes) {
+    raster::TaskPool pool(2);
+    raster::Renderer renderer(pool);
+    raster::RenderOptions options;
+    raster::Frame pinhole;
+    raster::LayeredTarget layers;
+    dof::MultiviewScratch scratch;
+    auto kept = [&](const raster::Scene& scene, const raster::View& view, const dof::ThinLens& lens,
+                    const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings) {
+        const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
+            return renderer.render(scene, v, options, f);
+        };
+        const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
+                                      raster::LayeredTarget& t) {
+            return renderer.renderLayers(scene, v, options, d, t);
+        };
+        dof::ShadingInputs shading;
+        shading.scene = &scene;
+        std::vector<float> rgba;
+        FOCAL_CHECK(dof::renderMultiview(view, lens, samples, settings, shading, scene.background,
+                                         pin, lay, pool, rgba, &pinhole, &layers, &scratch)
+                        .ok());
+        return hashFloats(rgba);
+    };
+    const BarCase bar = barCase(30.0f, 6.0f);
+    const dof::LensSampleSet bar_samples = makeSamples(16);
+    // A larger view with a glass pane (transparent planes and their mipmaps) and a lit quad.
+    const raster::View wide = pixelView(72, 56, 100.0f);
+    raster::Scene glass_scene = wallScene();
+    raster::Material glass = flatMaterial({0.2f, 0.4f, 0.9f, 0.4f}, raster::AlphaMode::Blend);
+    glass.unlit = false;
+    addQuad(glass_scene, 0.0f, -20.0f, 20.0f, 0.0f, 70.0f, addMaterial(glass_scene, glass));
+    addQuad(glass_scene, -20.0f, -5.0f, 8.0f, 15.0f, 60.0f,
+            addMaterial(glass_scene, flatMaterial({0.8f, 0.7f, 0.2f, 1.0f})));
+    const dof::ThinLens glass_lens = dof::makeThinLens(wide, 10.0f, 100.0f);
+    const dof::LensSampleSet glass_samples = makeSamples(24);
+
+    dof::MultiviewSettings defaults;
+    dof::MultiviewSettings no_misses;
+    no_misses.cone_misses = false;
+    dof::MultiviewSettings no_culling;
+    no_culling.culling = false;
+    no_culling.layers = 3;
+    dof::MultiviewSettings many_layers;
+    many_layers.layer_spacing_px = 0.5f;
+    struct Frame {
+        bool glass;
+        dof::MultiviewSettings settings;
+    };
+    for (const Frame& f :
+         {Frame{false, defaults}, Frame{true, many_layers}, Frame{false, no_misses},
+          Frame{true, no_culling}, Frame{false, exactSettings()}, Frame{false, defaults},
+          Frame{true, defaults}}) {
+        const raster::Scene& scene = f.glass ? glass_scene : bar.scene;
+        const raster::View& view = f.glass ? wide : bar.view;
+        const dof::ThinLens& lens = f.glass ? glass_lens : bar.lens;
+        const dof::LensSampleSet& samples = f.glass ? glass_samples : bar_samples;
+        EXPECT_EQ(kept(scene, view, lens, samples, f.settings),
+                  hashFloats(runMultiview(scene, view, lens, samples, f.settings).frame.color))
+            << (f.glass ? "glass scene" : "bar scene") << ", layers " << f.settings.layers;
+    }
+}
+
 TEST(Multiview, BothRoutingPoliciesAndOffscreenPoliciesRun) {
     const raster::View view = pixelView(64, 48, 100.0f);
     raster::Scene scene = wallScene();
