@@ -13,8 +13,10 @@
 # instead (review and commit them). DIR defaults to goldens/ beside the calling CMakeLists.txt;
 # LABELS default to "golden".
 #
-# The focal executable: FOCAL_EXECUTABLE if set, else the in-tree `focal` target. (An installed
-# package, issue 20, would set FOCAL_EXECUTABLE from its imported target.)
+# The focal executable: FOCAL_EXECUTABLE if set, else the target focal::focal-cli: in focal's
+# own tree an alias of the `focal` target, in a project that did find_package(focal) the
+# installed program (this file is then lib/cmake/focal/FocalGolden.cmake, included by
+# focalConfig.cmake).
 include_guard(GLOBAL)
 
 set(_focal_golden_check "${CMAKE_CURRENT_LIST_DIR}/FocalGoldenCheck.cmake")
@@ -33,10 +35,11 @@ function(focal_add_golden_test name scene)
   endif()
   if(FOCAL_EXECUTABLE)
     set(focal "${FOCAL_EXECUTABLE}")
-  elseif(TARGET focal)
-    set(focal "$<TARGET_FILE:focal>")
+  elseif(TARGET focal::focal-cli)
+    set(focal "$<TARGET_FILE:focal::focal-cli>")
   else()
-    message(FATAL_ERROR "focal_add_golden_test(${name}): set FOCAL_EXECUTABLE to the focal program")
+    message(FATAL_ERROR "focal_add_golden_test(${name}): no focal program: find_package(focal) "
+                        "from an install built with FOCAL_BUILD_APPS=ON, or set FOCAL_EXECUTABLE")
   endif()
 
   # The render options go through a generated file, one bracket-quoted argument each, so that no

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # README command (b): install what is missing, build, and run the whole test suite:
 # the Release build (every test: quick, full, golden and stress tiers; warnings as errors), the
-# ASan+UBSan build (quick tier), a clang++ Release build of focal and the golden tests (which must
-# match the same goldens as g++), ThreadSanitizer on the pinhole determinism sweeps, and each
-# libFuzzer target for 60 s (docs/testing.md, "What runs where"). Each step prints its wall time,
-# so a slow CI run shows where the time went.
+# installed package in projects outside the tree (tools/package-check.sh), the ASan+UBSan build
+# (quick tier), a clang++ Release build of focal and the golden tests (which must match the same
+# goldens as g++), ThreadSanitizer on the pinhole determinism sweeps, and each libFuzzer target
+# for 60 s (docs/testing.md, "What runs where"). Each step prints its wall time, so a slow CI run
+# shows where the time went.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$SECONDS
@@ -19,6 +20,9 @@ step "install" tools/install-deps.sh
 cmake --preset release >/dev/null
 step "release build" cmake --build --preset release -- -j"$jobs"
 step "release tests" ctest --preset release -j"$jobs"
+# The installed package in projects outside the tree: a library-only build (no OpenImageIO)
+# with examples/embed, and the release build's install with examples/golden-installed.
+step "package" tools/package-check.sh
 cmake --preset asan-ubsan >/dev/null
 step "asan-ubsan build" cmake --build --preset asan-ubsan --target focal focal_unit_tests -- -j"$jobs"
 step "asan-ubsan quick tier" ctest --preset asan-ubsan -j"$jobs" -L quick
