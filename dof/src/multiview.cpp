@@ -1,3 +1,4 @@
+#include <dof/float4.h>
 #include <dof/multiview.h>
 #include <raster/simd.h>
 #include <raster/surface_shading.h>
@@ -388,16 +389,6 @@ MipLevel mipLevelFor(const Tracer& tr, float diameter) {
     return {l0, std::min(l0 + 1, top), level - float(l0)};
 }
 
-// Four channels of a texel as one SSE vector (a GCC/clang vector extension, on the baseline
-// target as on AVX2): the lookups' arithmetic is element-wise, so each lane performs the same
-// IEEE operations in the same order as the scalar expression, and the bits do not change.
-using Channels4 = float __attribute__((vector_size(16)));
-inline Channels4 loadChannels4(const float* p) {
-    Channels4 v;
-    __builtin_memcpy(&v, p, sizeof v);
-    return v;
-}
-
 // Trilinear lookup of the first C channels of a layer mipmap `mip` with Stride channels per
 // texel (§4.4) at image position (px, py) on the levels `lv`. Channels 0-3 are weighted as one
 // vector (C = 2 reads four and keeps two: a texel has Stride >= 4 channels); a fifth is scalar.
@@ -405,7 +396,7 @@ template <int C, int Stride = C>
 std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel lv) {
     static_assert(C <= 5 && Stride >= 4 && Stride >= C);
     struct Taps {
-        Channels4 v;
+        Float4 v;
         float e; // channel 4 when C == 5
     };
     auto bilinear = [&](uint32_t level) {
@@ -436,8 +427,8 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
         }
         const float bu = 1.0f - au, bv = 1.0f - av;
         Taps out;
-        const Channels4 top_row = loadChannels4(r0 + x0) * bu + loadChannels4(r0 + x1) * au;
-        const Channels4 bottom = loadChannels4(r1 + x0) * bu + loadChannels4(r1 + x1) * au;
+        const Float4 top_row = loadFloat4(r0 + x0) * bu + loadFloat4(r0 + x1) * au;
+        const Float4 bottom = loadFloat4(r1 + x0) * bu + loadFloat4(r1 + x1) * au;
         out.v = top_row * bv + bottom * av;
         out.e = 0.0f;
         if constexpr (C == 5) {
