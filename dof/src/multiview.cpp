@@ -753,29 +753,64 @@ bool rayInside(const Tracer& tr, uint32_t x, uint32_t y, glm::vec2 w, float t) {
            o.y < float(tr.height - y);
 }
 
-// Early culling per pixel (§4.3).
+// One of a layer's per-pixel culling queries (§4.3), set up once per tile: boxCulled on the
+// window [x + lo, x + hi] x [y + lo, y + hi] around pixel (x, y) against `beyond`. Windows
+// inside the image are four N-buffer lookups (NBufferWindow, the same value as nBufferMin);
+// near the border boxCulled clamps them.
+struct PixelCull {
+    NBufferWindow window;
+    int64_t lo = 0, hi = 0;
+    float beyond = 0.0f;
+};
+
+PixelCull pixelCull(const Tracer& tr, uint32_t l, float r, float beyond) {
+    PixelCull c;
+    c.lo = int64_t(std::floor(0.5f - r)), c.hi = int64_t(std::floor(0.5f + r));
+    c.window = NBufferWindow(tr.scratch->nbuffers[l], c.hi - c.lo + 1);
+    c.beyond = beyond;
+    return c;
+}
+
+bool culledAt(const Tracer& tr, uint32_t l, const PixelCull& c, uint32_t x, uint32_t y) {
+    const int64_t x0 = int64_t(x) + c.lo, x1 = int64_t(x) + c.hi;
+    const int64_t y0 = int64_t(y) + c.lo, y1 = int64_t(y) + c.hi;
+    if (x0 >= 0 && y0 >= 0 && x1 < int64_t(tr.width) && y1 < int64_t(tr.height))
+        return c.window.minInside(x0, y0) > c.beyond;
+    return boxCulled(tr, l, x0, x1, y0, y1, c.beyond);
+}
+
+// A tile layer's three per-pixel queries: culled() with the cone margin and with margin 0, and
+// the window of the missed cones' first lookups against the owned interval's far bound.
+struct LayerCulls {
+    PixelCull cone, ray, first_cone;
+};
+
+LayerCulls layerCulls(const Tracer& tr, uint32_t l) {
+    const LayerSeg& seg = tr.segs[l];
+    return {pixelCull(tr, l, seg.reach_px + seg.cone_px, seg.t1),
+            pixelCull(tr, l, seg.reach_px, seg.t1), pixelCull(tr, l, seg.first_cone_px, seg.own1)};
+}
+
+// Early culling per pixel (§4.3). `culls`: layerCulls of each tile layer (with culling on).
 PixelLayers pixelLayers(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t* tile_layers,
-                        uint32_t tile_layer_count, TileCounters& cnt) {
+                        uint32_t tile_layer_count, const LayerCulls* culls, TileCounters& cnt) {
     const MultiviewSettings& s = *tr.settings;
     PixelLayers pl;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
         const uint32_t l = tile_layers[i];
         const float cone_px = tr.segs[l].cone_px;
-        if (s.culling && culled(tr, l, x, x, y, y, cone_px)) {
+        if (s.culling && culledAt(tr, l, culls[i].cone, x, y)) {
             ++cnt.culled_pixel;
             continue;
         }
-        const bool hittable = !s.culling || cone_px == 0.0f || !culled(tr, l, x, x, y, y, 0.0f);
+        const bool hittable = !s.culling || cone_px == 0.0f || !culledAt(tr, l, culls[i].ray, x, y);
         if (!hittable) {
             // Only the missed cones can see this layer. Their first lookup (missCone) reads
             // within first_cone_px of the pixel centre (clamped to the image, so nearer to it)
             // and finds coverage only where the layer owns a texel (depth <= own1): when none
             // is there, the layer holds nothing for this pixel. (Not asked of hittable layers:
             // the query costs more than the lookups it saves there.)
-            const float r = tr.segs[l].first_cone_px;
-            const int64_t lo = int64_t(std::floor(0.5f - r)), hi = int64_t(std::floor(0.5f + r));
-            if (boxCulled(tr, l, int64_t(x) + lo, int64_t(x) + hi, int64_t(y) + lo, int64_t(y) + hi,
-                          tr.segs[l].own1)) {
+            if (culledAt(tr, l, culls[i].first_cone, x, y)) {
                 ++cnt.culled_pixel;
                 continue;
             }
@@ -1089,11 +1124,15 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
     const uint32_t n = tr.samples->size();
     const uint32_t tw = x1 - x0;
+    std::array<LayerCulls, raster::kMaxLayers> culls;
+    if (tr.settings->culling)
+        for (uint32_t i = 0; i < tile_layer_count; ++i)
+            culls[i] = layerCulls(tr, tile_layers[i]);
     for (uint32_t y = y0; y < y1; ++y)
         for (uint32_t x = x0; x < x1; ++x) {
             const size_t p = size_t(y - y0) * tw + (x - x0);
             PixelLayers& pl = pixel_layers[p];
-            pl = pixelLayers(tr, x, y, tile_layers, tile_layer_count, cnt);
+            pl = pixelLayers(tr, x, y, tile_layers, tile_layer_count, culls.data(), cnt);
             if (tr.in_focus && !debugRecords(tr, x, y) &&
                 inFocusPixel(tr, x, y, pl, rgba + (size_t(y) * tr.width + x) * 4, cnt)) {
                 pl.active = 0;

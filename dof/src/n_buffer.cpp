@@ -76,6 +76,20 @@ float nBufferMin(const NBuffer& nb, int64_t x0, int64_t y0, int64_t size) {
     return m;
 }
 
+NBufferWindow::NBufferWindow(const NBuffer& nb, int64_t size) : nb_(&nb), size_(size) {
+    if (size <= 0 || nb.levels.empty() || size > int64_t(nb.width) || size > int64_t(nb.height))
+        return;
+    // nBufferMin's corner lookups for an unclipped window: side = size, squares of 2^n.
+    const uint32_t n = nBufferLevelFor(nb, uint32_t(size));
+    const int64_t s = int64_t(1) << n;
+    if (s * 2 < size)
+        return; // nBufferMin tiles the window: not enough levels for four squares
+    level_ = nb.levels[n].data();
+    width_ = nb.width;
+    far_ = size - s;
+    four_lookups_ = true;
+}
+
 float windowMinReference(const float* depth, uint32_t width, uint32_t height, int64_t x0,
                          int64_t y0, int64_t size) {
     float m = INFINITY;

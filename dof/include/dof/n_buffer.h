@@ -6,6 +6,7 @@
 // value above every real one); produces the levels, owned by the NBuffer.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -40,6 +41,32 @@ uint32_t nBufferLevelFor(const NBuffer& nb, uint32_t size);
 // return the minimum of a larger window, never a larger value than the true minimum).
 // Returns +inf when the clipped window is empty.
 float nBufferMin(const NBuffer& nb, int64_t x0, int64_t y0, int64_t size);
+
+// nBufferMin for many windows of one size (per-pixel culling over a tile): the level and the
+// far corners' offset are worked out once, so a window that lies inside the image is four
+// lookups. minInside(x0, y0) == nBufferMin(nb, x0, y0, size) for every window
+// [x0, x0+size) x [y0, y0+size) inside the image (the caller checks that; outside it, ask
+// nBufferMin).
+class NBufferWindow {
+public:
+    NBufferWindow() = default;
+    NBufferWindow(const NBuffer& nb, int64_t size);
+    float minInside(int64_t x0, int64_t y0) const {
+        if (!four_lookups_)
+            return nBufferMin(*nb_, x0, y0, size_);
+        const float* r0 = level_ + size_t(y0) * width_ + size_t(x0);
+        const float* r1 = r0 + size_t(far_) * width_;
+        return std::min(std::min(r0[0], r0[far_]), std::min(r1[0], r1[far_]));
+    }
+
+private:
+    const NBuffer* nb_ = nullptr;
+    const float* level_ = nullptr;
+    size_t width_ = 0;
+    int64_t size_ = 0;
+    int64_t far_ = 0; // size - 2^n: the far corners' offset
+    bool four_lookups_ = false;
+};
 
 // The same minimum by brute force (the reference the tests compare with).
 float windowMinReference(const float* depth, uint32_t width, uint32_t height, int64_t x0,

@@ -59,4 +59,25 @@ TEST(NBuffer, TooFewLevelsStayConservative) {
                   dof::windowMinReference(d.data(), w, h, 0, 0, size));
 }
 
+// NBufferWindow (one size, many positions) returns nBufferMin's value for every window inside
+// the image, with levels enough for four lookups and with too few (nBufferMin then tiles).
+TEST(NBuffer, WindowOfOneSizeMatchesTheQueryInsideTheImage) {
+    const uint32_t w = 41, h = 29;
+    const std::vector<float> d = hashedDepth(w, h);
+    for (uint32_t max_level : {16u, 1u}) {
+        dof::NBuffer nb;
+        dof::buildNBuffer(d.data(), w, h, max_level, nb);
+        for (int64_t size = 1; size <= 29; ++size) {
+            const dof::NBufferWindow window(nb, size);
+            for (int64_t y = 0; y + size <= int64_t(h); ++y)
+                for (int64_t x = 0; x + size <= int64_t(w); ++x) {
+                    ASSERT_EQ(window.minInside(x, y), dof::nBufferMin(nb, x, y, size))
+                        << size << " at " << x << "," << y << ", levels to " << max_level;
+                    ASSERT_EQ(window.minInside(x, y),
+                              dof::windowMinReference(d.data(), w, h, x, y, size));
+                }
+        }
+    }
+}
+
 } // namespace
