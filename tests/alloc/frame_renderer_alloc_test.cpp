@@ -6,6 +6,7 @@
 
 #include <dof/frame_renderer.h>
 #include <raster/check.h>
+#include <raster/renderer.h>
 #include <scenes/builtin.h>
 
 #include <gtest/gtest.h>
@@ -145,6 +146,20 @@ TEST(FrameRendererAllocations, SecondIdenticalFramePerMethod) {
     const dof::FrameImage image{rgba.data(), size_t(view.width) * 4, nullptr, 0};
     for (uint32_t threads : {0u, 2u}) {
         raster::TaskPool pool(threads);
+        {
+            // The baseline: a second Renderer::render into a kept frame, outside any method.
+            raster::Renderer renderer(pool);
+            raster::Frame frame;
+            ASSERT_TRUE(renderer.render(*scene, view, {}, frame).ok());
+            raster::Status second;
+            const Count c = counted([&] { second = renderer.render(*scene, view, {}, frame); });
+            ASSERT_TRUE(second.ok());
+            std::printf("focal: second Renderer::render alone, %ux%u, %u threads: %llu "
+                        "allocations, %llu bytes\n",
+                        view.width, view.height, threads,
+                        static_cast<unsigned long long>(c.allocations),
+                        static_cast<unsigned long long>(c.bytes));
+        }
         for (const auto& [name, method] : methods) {
             dof::FrameRenderer frames(pool);
             dof::FrameReport report;
