@@ -19,6 +19,7 @@ struct Fixture {
     raster::Scene scene;
     dof::LensSampleSet samples = makeSamples(64);
     dof::LensSampleSet few = makeSamples(8);
+    dof::LensSampleSet other = makeSamples(12, {}, dof::LensPattern::Halton, 3);
 };
 
 const Fixture& fixture() {
@@ -66,6 +67,11 @@ dof::MethodSettings methodNamed(const std::string& name) {
         dof::MultiviewSettings s;
         s.jitter = dof::JitterMode::Halton;
         return dof::MultiviewMethod{s, &f.few};
+    }
+    if (name == "multiview_halton_other") { // another sample set: another 2N sequence
+        dof::MultiviewSettings s;
+        s.jitter = dof::JitterMode::Halton;
+        return dof::MultiviewMethod{s, &f.other};
     }
     if (name == "multilayer")
         return dof::MultilayerMethod{{}, &f.samples};
@@ -253,12 +259,22 @@ TEST(FrameRenderer, RepeatedFramesGiveTheBytesOfAFreshRenderer) {
         uint32_t width, height;
     };
     // Same and different sizes and methods one after another, every method at least twice.
-    const std::vector<Step> steps = {
-        {"multiview", 64, 48},        {"multiview", 64, 48},  {"gather", 32, 24},
-        {"multilayer", 64, 48},       {"multiview", 40, 56},  {"accum", 64, 48},
-        {"multilayer_box", 24, 16},   {"pinhole", 64, 48},    {"gather", 64, 48},
-        {"multiview_halton", 64, 48}, {"multilayer", 64, 48}, {"accum", 32, 24},
-        {"multiview", 64, 48},        {"pinhole", 16, 8},     {"gather", 32, 24}};
+    const std::vector<Step> steps = {{"multiview", 64, 48},
+                                     {"multiview", 64, 48},
+                                     {"gather", 32, 24},
+                                     {"multilayer", 64, 48},
+                                     {"multiview", 40, 56},
+                                     {"accum", 64, 48},
+                                     {"multilayer_box", 24, 16},
+                                     {"pinhole", 64, 48},
+                                     {"gather", 64, 48},
+                                     {"multiview_halton", 64, 48},
+                                     {"multiview_halton_other", 64, 48},
+                                     {"multilayer", 64, 48},
+                                     {"accum", 32, 24},
+                                     {"multiview", 64, 48},
+                                     {"pinhole", 16, 8},
+                                     {"gather", 32, 24}};
     raster::TaskPool pool(2);
     dof::FrameRenderer kept(pool);
     for (size_t i = 0; i < steps.size(); ++i) {
