@@ -4,12 +4,11 @@
 
 #include <dof/gather.h>
 #include <raster/camera.h>
-#include <raster/frame.h>
-#include <raster/renderer.h>
 
-#include <chrono>
 #include <memory>
 #include <string>
+#include <variant>
+#include <vector>
 
 namespace focal {
 
@@ -20,55 +19,34 @@ struct GatherArgs {
     dof::GatherSettings settings;
     bool no_skip = false;
     std::string coc_out;
+    std::vector<float> coc; // the signed CoC map of the last frame (with coc_out)
 };
 
-raster::Status runGather(const GatherArgs& args, const MethodInput& in, MethodOutput& out) {
-    dof::GatherSettings settings = args.settings;
-    settings.tile_size = in.options.tile_size;
-    settings.skip_tiles = !args.no_skip;
-    settings.simd = in.options.simd;
-    if (raster::Status s = dof::validate(settings); !s.ok())
-        return s;
-    if (raster::Status s = dof::validate(in.lens, in.view); !s.ok())
+raster::Result<dof::MethodSettings> gatherSettings(GatherArgs& args, const MethodContext& in) {
+    dof::GatherMethod m;
+    m.settings = args.settings;
+    m.settings.tile_size = in.options.tile_size; // as dof::FrameRenderer runs it
+    m.settings.skip_tiles = !args.no_skip;
+    m.settings.simd = in.options.simd;
+    if (raster::Status s = dof::validate(m.settings); !s.ok())
         return s;
     if (!args.coc_out.empty() && !isLinearFormat(args.coc_out))
         return raster::Status::error(args.coc_out + ": --gather-coc-out must be an .exr file");
+    if (!args.coc_out.empty())
+        m.coc_out = &args.coc;
+    return dof::MethodSettings(m);
+}
 
-    // The pinhole frame through the lens centre (§5: the application renders as before).
-    const auto t0 = std::chrono::steady_clock::now();
-    raster::View pinhole = in.view;
-    pinhole.lens_offset = glm::vec2(0.0f);
-    pinhole.pixel_shift = glm::vec2(0.0f);
-    MethodBuffers local;
-    MethodBuffers& buffers = in.buffers ? *in.buffers : local;
-    raster::Frame& frame = buffers.pinhole;
-    if (raster::Status s = buffers.renderer(in.pool).render(in.scene, pinhole, in.options, frame);
-        !s.ok())
-        return s;
-    const double ms_render =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-
-    dof::GatherImage image;
-    image.rgba = frame.color.data();
-    image.depth = dof::depthRefOf(frame.depth);
-    image.width = frame.width;
-    image.height = frame.height;
-    std::vector<float> coc;
-    raster::Result<dof::GatherStats> r =
-        dof::gather(image, in.lens, pinhole, settings, out.rgba,
-                    args.coc_out.empty() ? nullptr : &coc, &in.pool);
-    if (!r.ok())
-        return r.status();
+raster::Status finishGather(GatherArgs& args, const MethodContext& in,
+                            const dof::MethodSettings& method, const dof::FrameReport& report,
+                            MethodOutput& out) {
+    const dof::GatherSettings& settings = std::get<dof::GatherMethod>(method).settings;
+    const dof::GatherStats& st = std::get<dof::GatherStats>(report.method_stats);
     if (!args.coc_out.empty()) {
-        ImageData img{frame.width, frame.height, 1, std::move(coc)};
+        ImageData img{in.view.width, in.view.height, 1, args.coc};
         if (raster::Status s = writeImage(args.coc_out, img); !s.ok())
             return s;
     }
-
-    out.depth.resize(size_t(frame.width) * frame.height);
-    for (size_t i = 0; i < out.depth.size(); ++i)
-        out.depth[i] = raster::distanceFromDepth(pinhole, frame.depth.load(i));
-    const dof::GatherStats& st = *r;
     out.params = {{"max_radius_px", settings.max_radius_px},
                   {"leak_scale", settings.leak_scale},
                   {"min_radius_px", settings.min_radius_px},
@@ -76,7 +54,7 @@ raster::Status runGather(const GatherArgs& args, const MethodInput& in, MethodOu
                   {"skip_tiles", settings.skip_tiles},
                   {"simd", settings.simd},
                   {"depth_format",
-                   frame.depth.format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"},
+                   in.options.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"},
                   {"coc_a_px", st.coc.a},
                   {"coc_b_px", st.coc.b}};
     out.counts = {{"tiles", st.tiles},
@@ -87,10 +65,6 @@ raster::Status runGather(const GatherArgs& args, const MethodInput& in, MethodOu
                   {"clamped_pixels", st.clamped_pixels},
                   {"min_coc_px", st.min_coc_px},
                   {"max_coc_px", st.max_coc_px}};
-    out.stage_ms = {{"render", ms_render},
-                    {"coc", st.ms_coc},
-                    {"vertical", st.ms_vertical},
-                    {"horizontal", st.ms_horizontal}};
     return {};
 }
 
@@ -124,7 +98,11 @@ MethodEntry makeGatherMethod() {
         render.add_option("--gather-coc-out", args->coc_out,
                           "gather: also write the signed CoC map (pixels) to this EXR");
     };
-    e.run = [args](const MethodInput& in, MethodOutput& out) { return runGather(*args, in, out); };
+    e.settings = [args](const MethodContext& in) { return gatherSettings(*args, in); };
+    e.finish = [args](const MethodContext& in, const dof::MethodSettings& method,
+                      const dof::FrameRenderer&, const dof::FrameReport& report,
+                      const std::vector<float>&,
+                      MethodOutput& out) { return finishGather(*args, in, method, report, out); };
     return e;
 }
 

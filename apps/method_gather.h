@@ -1,6 +1,6 @@
 // `focal render --method gather`: Zhou, Chen & Pullen 2007 (dof/gather.h) as a method table
-// entry. Renders the pinhole frame with raster::Renderer, then runs the two-pass filter on its
-// colour and stored depth; stage times "render", "coc", "vertical", "horizontal".
+// entry: its options as a dof::GatherMethod (dof::FrameRenderer filters the shared pinhole frame;
+// stage times "render", "coc", "vertical", "horizontal"), --gather-coc-out and its --stats.
 #pragma once
 
 #include "apps/dof_method.h"

@@ -3,15 +3,14 @@
 #include "apps/image_io.h"
 
 #include <dof/multilayer.h>
-#include <raster/camera.h>
-#include <raster/fragment_lists.h>
-#include <raster/renderer.h>
 
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
+#include <variant>
+#include <vector>
 
 namespace focal {
 
@@ -44,22 +43,8 @@ const char* kindName(dof::LevelKind k) {
     return "?";
 }
 
-// Per-axis second moment of the aperture from the lens samples when there are enough of them to
-// describe its shape; the uniform disk's 1/4 otherwise.
-double apertureSecondMoment(const dof::LensSampleSet& samples) {
-    if (samples.size() < 64)
-        return 0.25;
-    double m = 0.0, w = 0.0;
-    for (const dof::LensSample& s : samples.samples()) {
-        m += double(s.weight) * 0.5 *
-             (double(s.position.x) * double(s.position.x) +
-              double(s.position.y) * double(s.position.y));
-        w += double(s.weight);
-    }
-    return w > 0.0 && m > 0.0 ? m / w : 0.25;
-}
-
-raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, MethodOutput& out) {
+raster::Result<dof::MethodSettings> multilayerSettings(const MultilayerArgs& args,
+                                                       const MethodContext& in) {
     dof::MultilayerSettings settings = args.settings;
     if (args.stack_levels == "auto") {
         settings.stack_levels = -1;
@@ -79,8 +64,6 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     settings.blend = args.blend == "additive" ? dof::LayerBlend::Additive : dof::LayerBlend::Over;
     settings.filter =
         args.filter == "aperture" ? dof::LevelFilter::Aperture : dof::LevelFilter::Box;
-    if (in.aperture)
-        settings.aperture = *in.aperture;
     settings.mean_depth = args.merge_depth == "mean";
     if (args.additive_gap == "inf") {
         settings.additive_gap = std::numeric_limits<float>::infinity();
@@ -96,32 +79,21 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
     }
     settings.color_format = in.target_color.value_or(raster::ColorFormat::Half);
     settings.depth_format = in.target_depth.value_or(raster::DepthFormat::Float32);
-    settings.aperture_second_moment = apertureSecondMoment(in.lens_samples);
-    settings.memory_budget = in.options.memory_budget;
     settings.level_contributions = !args.levels_out.empty();
+    // dof::FrameRenderer takes the aperture, its second moment and the memory budget from the
+    // lens samples and the raster options.
+    return dof::MethodSettings(dof::MultilayerMethod{settings, &in.lens_samples});
+}
 
-    raster::View pinhole = in.view;
-    pinhole.lens_offset = glm::vec2(0.0f);
-    pinhole.pixel_shift = glm::vec2(0.0f);
-    MethodBuffers local;
-    MethodBuffers& buffers = in.buffers ? *in.buffers : local;
-    raster::Renderer& renderer = buffers.renderer(in.pool);
-    raster::FrameStats raster_stats;
-    const dof::CollectFn collect = [&](const raster::FragmentListDesc& desc,
-                                       raster::FragmentLists& lists) {
-        return renderer.renderFragmentLists(in.scene, pinhole, in.options, desc, lists,
-                                            &raster_stats);
-    };
-    dof::Multilayer& multilayer = buffers.multilayer;
-    dof::MultilayerImage image;
-    dof::MultilayerStats st;
-    if (raster::Status s = multilayer.render(pinhole, in.lens, in.scene.background, settings,
-                                             collect, in.pool, image, &st);
-        !s.ok())
-        return s;
-
+raster::Status finishMultilayer(const MultilayerArgs& args, const dof::MethodSettings& method,
+                                const dof::FrameRenderer& frames, const dof::FrameReport& report,
+                                MethodOutput& out) {
+    const dof::MultilayerSettings& settings = std::get<dof::MultilayerMethod>(method).settings;
+    const dof::MultilayerStats& st = std::get<dof::MultilayerStats>(report.method_stats);
+    const raster::FrameStats& raster_stats = report.collect;
     if (!args.levels_out.empty()) {
         // One image per level (premultiplied contribution) and the background's share.
+        const dof::MultilayerImage& image = frames.multilayerImage();
         for (size_t s = 0; s < image.level_rgba.size(); ++s) {
             ImageData img{image.width, image.height, 4, image.level_rgba[s]};
             for (size_t i = 0; i < img.pixels.size() / 4; ++i)
@@ -134,10 +106,6 @@ raster::Status runMultilayer(const MultilayerArgs& args, const MethodInput& in, 
         }
     }
 
-    out.rgba = std::move(image.rgba);
-    out.depth = std::move(image.depth);
-    out.stage_ms = {
-        {"collect", st.ms_collect}, {"filter", st.ms_filter}, {"accumulate", st.ms_accumulate}};
     out.params = {
         {"fragments_per_pixel", settings.fragments_per_pixel},
         {"skip_hidden", settings.skip_hidden},
@@ -281,8 +249,11 @@ MethodEntry makeMultilayerMethod() {
                           "multilayer: write each level's contribution (Fig. 7) to "
                           "PREFIXlevelS.png and PREFIXbackground.png");
     };
-    e.run = [args](const MethodInput& in, MethodOutput& out) {
-        return runMultilayer(*args, in, out);
+    e.settings = [args](const MethodContext& in) { return multilayerSettings(*args, in); };
+    e.finish = [args](const MethodContext&, const dof::MethodSettings& method,
+                      const dof::FrameRenderer& frames, const dof::FrameReport& report,
+                      const std::vector<float>&, MethodOutput& out) {
+        return finishMultilayer(*args, method, frames, report, out);
     };
     return e;
 }

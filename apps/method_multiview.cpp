@@ -4,7 +4,6 @@
 
 #include <dof/multiview.h>
 #include <dof/n_buffer.h>
-#include <raster/renderer.h>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -17,6 +16,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
+#include <vector>
 
 namespace focal {
 
@@ -45,6 +46,9 @@ struct MultiviewArgs {
     float env_intensity = 1.0f;
     std::string debug_out;   // prefix of the debug pictures; empty: none
     std::string debug_pixel; // "X,Y"; empty: the image centre
+    // Read by the settings of the last frame: the environment map and the debug pixel's rays.
+    dof::EnvironmentMap env;
+    std::vector<dof::MultiviewRayRecord> debug_rays;
 };
 
 // --- Debug pictures (--multiview-debug-out): layers, N-buffer levels, one pixel's rays ---------
@@ -273,7 +277,7 @@ std::optional<float> parseThickness(const std::string& text) {
     return v;
 }
 
-raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, MethodOutput& out) {
+raster::Result<dof::MethodSettings> multiviewSettings(MultiviewArgs& a, const MethodContext& in) {
     dof::MultiviewSettings s;
     s.layer_spacing_px = a.layer_spacing;
     s.layers = a.layers;
@@ -299,11 +303,11 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
     s.view_dependent = a.view_dependent;
     s.cone_shading =
         a.cone_shading == "centre" ? dof::ConeShading::Centre : dof::ConeShading::Footprint;
-    s.seed = in.lens_samples.seed();
     s.color_format = in.target_color.value_or(raster::ColorFormat::Half);
     s.depth_format = in.target_depth.value_or(raster::DepthFormat::Float32);
 
-    dof::EnvironmentMap env;
+    dof::EnvironmentMap& env = a.env;
+    env = dof::EnvironmentMap{};
     if (!a.env_map.empty()) {
         raster::Result<ImageData> img = readImage(a.env_map);
         if (!img.ok())
@@ -318,32 +322,8 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                     img->pixels[i * img->channels + std::min(c, img->channels - 1)];
         s.env_map = &env;
     }
-    // §4.5's 2N-sample sequence: a Halton sequence on the same aperture, twice as many samples.
-    std::optional<dof::LensSampleSet> seq;
-    if (s.jitter == dof::JitterMode::Halton) {
-        raster::Result<dof::LensSampleSet> r = dof::LensSampleSet::create(
-            in.aperture ? *in.aperture : dof::ApertureShape{}, dof::LensPattern::Halton,
-            2 * in.lens_samples.size(), in.lens_samples.seed());
-        if (!r.ok())
-            return r.status();
-        seq = std::move(*r);
-        s.sequence_2n = &*seq;
-    }
-
-    MethodBuffers local;
-    MethodBuffers& buffers = in.buffers ? *in.buffers : local;
-    raster::Renderer& renderer = buffers.renderer(in.pool);
-    raster::Frame& pinhole = buffers.pinhole;
-    raster::LayeredTarget& layers = buffers.layers;
-    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
-        return renderer.render(in.scene, v, in.options, f);
-    };
-    const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                  raster::LayeredTarget& t) {
-        return renderer.renderLayers(in.scene, v, in.options, d, t);
-    };
     // --multiview-debug-out: record the rays of one pixel.
-    std::vector<dof::MultiviewRayRecord> debug_rays;
+    a.debug_rays.clear();
     if (!a.debug_out.empty()) {
         s.debug_x = in.view.width / 2;
         s.debug_y = in.view.height / 2;
@@ -358,29 +338,25 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
             s.debug_x = dx;
             s.debug_y = dy;
         }
-        s.debug_rays = &debug_rays;
+        s.debug_rays = &a.debug_rays;
         s.skip_unblurred = false; // the pictures show every stage, even for a sharp image
     }
-    dof::ShadingInputs shading;
-    shading.scene = &in.scene;
-    shading.simd = in.options.simd;
-    raster::Result<dof::MultiviewStats> r =
-        dof::renderMultiview(in.view, in.lens, in.lens_samples, s, shading, in.scene.background,
-                             pin, lay, in.pool, out.rgba, &pinhole, &layers, &buffers.multiview);
-    if (!r.ok())
-        return r.status();
-    const dof::MultiviewStats& st = *r;
+    // dof::FrameRenderer takes the seed and §4.5's Halton sequence from the lens samples.
+    return dof::MethodSettings(dof::MultiviewMethod{s, &in.lens_samples});
+}
+
+raster::Status finishMultiview(MultiviewArgs& a, const MethodContext& in,
+                               const dof::MethodSettings& method, const dof::FrameRenderer& frames,
+                               const dof::FrameReport& report, const std::vector<float>& rgba,
+                               MethodOutput& out) {
+    const dof::MultiviewSettings& s = std::get<dof::MultiviewMethod>(method).settings;
+    const dof::MultiviewStats& st = std::get<dof::MultiviewStats>(report.method_stats);
+    const raster::LayeredTarget& layers = frames.multiviewLayers();
     if (!a.debug_out.empty() && layers.layer_count > 0) {
-        if (raster::Status ds =
-                writeDebugPictures(a.debug_out, in.view, layers, out.rgba, debug_rays, s.debug_x,
-                                   s.debug_y, st.d_near, st.d_far);
+        if (raster::Status ds = writeDebugPictures(a.debug_out, in.view, layers, rgba, a.debug_rays,
+                                                   s.debug_x, s.debug_y, st.d_near, st.d_far);
             !ds.ok())
             return raster::Status::error("--multiview-debug-out: " + ds.message());
-    }
-    out.depth.resize(size_t(pinhole.width) * pinhole.height);
-    for (size_t i = 0; i < out.depth.size(); ++i) {
-        const float d = pinhole.depth.load(i);
-        out.depth[i] = d < 1.0f ? raster::distanceFromDepth(in.view, d) : INFINITY;
     }
     out.params = {
         {"samples", in.lens_samples.size()},
@@ -438,11 +414,6 @@ raster::Status runMultiview(const MultiviewArgs& a, const MethodInput& in, Metho
                   {"path_cells", st.path_cells},
                   {"layered_bytes", st.layered_bytes},
                   {"scratch_bytes", st.scratch_bytes}};
-    out.stage_ms = {{"pinhole", st.ms_pinhole},
-                    {"decomposition", st.ms_decomposition},
-                    {"nbuffer", st.ms_nbuffer},
-                    {"mipmaps", st.ms_mipmaps},
-                    {"tracing", st.ms_tracing}};
     return {};
 }
 
@@ -551,8 +522,11 @@ MethodEntry makeMultiviewMethod() {
                        "multiview: X,Y of the pixel whose rays --multiview-debug-out draws "
                        "[default: the centre]");
     };
-    e.run = [args](const MethodInput& in, MethodOutput& out) {
-        return runMultiview(*args, in, out);
+    e.settings = [args](const MethodContext& in) { return multiviewSettings(*args, in); };
+    e.finish = [args](const MethodContext& in, const dof::MethodSettings& method,
+                      const dof::FrameRenderer& frames, const dof::FrameReport& report,
+                      const std::vector<float>& rgba, MethodOutput& out) {
+        return finishMultiview(*args, in, method, frames, report, rgba, out);
     };
     e.minimum_bytes = [args](const raster::View& view, uint32_t samples, uint32_t workers) {
         dof::MultiviewSettings s;

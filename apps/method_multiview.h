@@ -1,5 +1,6 @@
 // `focal render --method multiview`: Lee, Eisemann & Seidel 2009 (dof/multiview.h) on the
-// command line. Adds the method's options to the render command and runs it from a MethodInput.
+// command line: its options as a dof::MultiviewMethod (rendered by dof::FrameRenderer), the
+// --multiview-debug-out pictures and its --stats.
 #pragma once
 
 #include "apps/dof_method.h"

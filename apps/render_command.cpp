@@ -8,6 +8,7 @@
 #include "apps/text_file.h"
 
 #include <dof/accum.h>
+#include <dof/frame_renderer.h>
 #include <dof/layer_spacing.h>
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
@@ -543,20 +544,11 @@ int runRender(const RenderArgs& args) {
         !s.ok())
         return fail(s.message());
 
-    raster::Renderer renderer(pool);
-    raster::Frame frame;
+    // Every frame of this command (autofocus, each --repeat run, the dumps) is rendered by one
+    // FrameRenderer: it keeps the renderer, the methods' buffers and the pinhole frame.
+    dof::FrameRenderer frames(pool);
+    // Counts of the last renderer call (--stats "triangles", "fragments").
     raster::FrameStats stats;
-    // Stage times summed over every renderer call of one run.
-    raster::FrameStats run_sum;
-    auto renderView = [&](const raster::View& v, raster::Frame& out) {
-        raster::FrameStats one;
-        Status s = renderer.render(*scene, v, options, out, &one);
-        run_sum.ms_geometry += one.ms_geometry;
-        run_sum.ms_binning += one.ms_binning;
-        run_sum.ms_raster += one.ms_raster;
-        stats = one;
-        return s;
-    };
 
     // Resolve the lens: aperture, then focus distance (docs/dof/lens.md, "Defaults").
     LensChoice choice;
@@ -577,13 +569,13 @@ int runRender(const RenderArgs& args) {
         focus_distance = *args.focus_distance;
         choice.focus_source = "cli";
     } else if (!args.dry_run && (args.focus_pixel || (uses_lens && !look_at && !scene->lens))) {
-        // Render the pinhole (independent of the lens) and read its depth.
+        // Render the pinhole (independent of the lens) and read its depth; the frame renderer
+        // keeps it for the first frame, whose methods read the same pinhole.
         const auto t0 = std::chrono::steady_clock::now();
-        raster::View pin = *view;
-        pin.lens_offset = glm::vec2(0.0f);
-        pin.pixel_shift = glm::vec2(0.0f);
-        if (Status s = renderView(pin, frame); !s.ok())
-            return fail(s.message());
+        Result<const raster::Frame*> pinhole = frames.pinhole(*scene, *view, options, &stats);
+        if (!pinhole.ok())
+            return fail(pinhole.status().message());
+        const raster::Frame& frame = **pinhole;
         choice.ms_focus =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                 .count();
@@ -637,45 +629,63 @@ int runRender(const RenderArgs& args) {
         return 0;
     }
 
+    const MethodContext method_context{*view, *lens_samples, options, target_color, target_depth};
     MethodOutput method_out;
-    MethodBuffers method_buffers; // reused by every run (--repeat)
     std::vector<std::pair<std::string, std::vector<double>>> method_stage_ms;
+    // The image every run writes (linear RGBA) and the depth --depth-out asks for.
+    const size_t pixels = size_t(view->width) * view->height;
+    std::vector<float> color(pixels * 4);
+    std::vector<float> depth_image(args.depth_out.empty() ? 0 : pixels);
+    dof::FrameImage image;
+    image.rgba = color.data();
+    image.stride = size_t(view->width) * 4;
+    image.depth = depth_image.empty() ? nullptr : depth_image.data();
+    image.depth_stride = view->width;
 
     nlohmann::json runs = nlohmann::json::array();
-    std::vector<double> totals, geometry, binning, raster_ms, pinhole_ms, views_ms, accum_ms;
+    std::vector<double> totals, geometry, binning, raster_ms;
     dof::AccumStats accum_stats;
+    dof::FrameReport report;
     const bool show_progress =
         is_accum && !args.no_progress && args.samples > 1 && ::isatty(::fileno(stderr)) == 1;
     for (uint32_t run = 0; run < args.repeat; ++run) {
-        run_sum = raster::FrameStats{};
         const auto start = std::chrono::steady_clock::now();
+        ProgressBar bar(show_progress);
+        dof::MethodSettings method;
         if (is_accum) {
-            ProgressBar bar(show_progress);
-            dof::AccumSettings settings;
-            settings.pixel_jitter = args.pixel_jitter;
-            Result<dof::AccumStats> r = dof::renderAccum(
-                *view, choice.lens, *lens_samples, settings, renderView, frame, &pool,
-                [&bar](uint32_t done, uint32_t total) { bar.update(done, total); });
-            if (!r.ok())
-                return fail(r.status().message());
-            accum_stats = *r;
+            dof::AccumMethod accum;
+            accum.settings.pixel_jitter = args.pixel_jitter;
+            accum.samples = &*lens_samples;
+            accum.progress = [&bar](uint32_t done, uint32_t total) { bar.update(done, total); };
+            method = std::move(accum);
         } else if (table_method) {
-            MethodInput in{*scene,  *view,        choice.lens,  *lens_samples,    pool,
-                           options, target_color, target_depth, &*aperture_shape, &method_buffers};
-            method_out = MethodOutput{};
-            if (Status s = table_method->run(in, method_out); !s.ok())
-                return fail(s.message());
-            if (method_out.rgba.size() != size_t(view->width) * view->height * 4)
-                return fail("--method " + args.method + " returned an image of the wrong size");
-            frame.width = view->width;
-            frame.height = view->height;
-            frame.color = method_out.rgba;
-        } else if (Status s = renderView(*view, frame); !s.ok()) {
+            Result<dof::MethodSettings> m = table_method->settings(method_context);
+            if (!m.ok())
+                return fail(m.status().message());
+            method = std::move(*m);
+        }
+        if (Status s = frames.render(*scene, *view, choice.lens, options, method, image, &report);
+            !s.ok())
             return fail(s.message());
+        if (table_method) {
+            method_out = MethodOutput{};
+            if (Status s =
+                    table_method->finish(method_context, method, frames, report, color, method_out);
+                !s.ok())
+                return fail(s.message());
         }
         const double total =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
+        // Renderer stage times of pinhole and accum (the table methods report their own stages).
+        raster::FrameStats run_sum;
+        if (!table_method) {
+            run_sum = report.render_sum;
+            if (report.renders > 0)
+                stats = report.last_render;
+        }
+        if (is_accum)
+            accum_stats = std::get<dof::AccumStats>(report.method_stats);
         totals.push_back(total);
         geometry.push_back(run_sum.ms_geometry);
         binning.push_back(run_sum.ms_binning);
@@ -684,16 +694,8 @@ int runRender(const RenderArgs& args) {
                               {"geometry", run_sum.ms_geometry},
                               {"binning", run_sum.ms_binning},
                               {"raster", run_sum.ms_raster}};
-        if (is_accum) {
-            pinhole_ms.push_back(accum_stats.ms_pinhole);
-            views_ms.push_back(accum_stats.ms_views);
-            accum_ms.push_back(accum_stats.ms_accumulate);
-            one["pinhole"] = accum_stats.ms_pinhole;
-            one["views"] = accum_stats.ms_views;
-            one["accumulate"] = accum_stats.ms_accumulate;
-        }
-        for (size_t k = 0; k < method_out.stage_ms.size(); ++k) {
-            const auto& [stage, ms] = method_out.stage_ms[k];
+        for (size_t k = 0; k < report.stage_ms.size(); ++k) {
+            const auto& [stage, ms] = report.stage_ms[k];
             one[stage] = ms;
             if (method_stage_ms.size() <= k)
                 method_stage_ms.push_back({stage, {}});
@@ -705,32 +707,14 @@ int runRender(const RenderArgs& args) {
         std::fprintf(stderr, "focal: note: accum rendered once: %s\n",
                      accum_stats.skip_reason.c_str());
 
-    ImageData color{frame.width, frame.height, 4, frame.color};
+    ImageData color_out{view->width, view->height, 4, std::move(color)};
     for (const std::string& output : args.outputs)
-        if (Status s = writeImage(output, color); !s.ok())
+        if (Status s = writeImage(output, color_out); !s.ok())
             return fail(s.message());
     if (!args.depth_out.empty()) {
-        // The pinhole depth: pinhole and accum leave it in the frame; a table method returns
-        // its own, or gets a pinhole render here.
-        ImageData depth{frame.width, frame.height, 1, {}};
-        if (table_method && !method_out.depth.empty()) {
-            depth.pixels = method_out.depth;
-        } else {
-            if (table_method) {
-                raster::View pin = *view;
-                pin.lens_offset = glm::vec2(0.0f);
-                pin.pixel_shift = glm::vec2(0.0f);
-                raster::Frame depth_frame;
-                if (Status s = renderer.render(*scene, pin, options, depth_frame); !s.ok())
-                    return fail(s.message());
-                frame.depth = std::move(depth_frame.depth);
-            }
-            depth.pixels.resize(size_t(frame.width) * frame.height);
-            for (size_t i = 0; i < depth.pixels.size(); ++i)
-                depth.pixels[i] = raster::distanceFromDepth(*view, frame.depth.load(uint32_t(i)));
-        }
-        if (depth.pixels.size() != size_t(frame.width) * frame.height)
-            return fail("--method " + args.method + " returned a depth image of the wrong size");
+        // The method's depth (dof::FrameImage::depth): the pinhole's for pinhole, accum and
+        // gather.
+        ImageData depth{view->width, view->height, 1, std::move(depth_image)};
         if (Status s = writeImage(args.depth_out, depth); !s.ok())
             return fail(s.message());
     }
@@ -738,9 +722,16 @@ int runRender(const RenderArgs& args) {
     // range, uniform in 1/d, with the paper's routing; fragment lists with the closest K kept.
     nlohmann::json target_stats;
     if (!args.dump_layers.empty() || !args.dump_fragments.empty()) {
-        raster::Frame pinhole;
-        if (Status s = renderer.render(*scene, *view, options, pinhole); !s.ok())
-            return fail(s.message());
+        // The last frame's pinhole when it is this view's, else a new render.
+        raster::Frame rendered;
+        const raster::Frame* kept = frames.lastPinhole(*scene, *view, options);
+        if (!kept) {
+            if (Status s = frames.renderer().render(*scene, *view, options, rendered); !s.ok())
+                return fail(s.message());
+            kept = &rendered;
+        }
+        const raster::Frame& pinhole = *kept;
+        raster::Renderer& renderer = frames.renderer();
         if (!args.dump_layers.empty()) {
             const dof::DepthRange range = dof::visibleDepthRange(pinhole, *view);
             if (!range.covered)
@@ -855,9 +846,6 @@ int runRender(const RenderArgs& args) {
                      {"images_decoded", load_stats.images_decoded},
                      {"images_skipped", load_stats.images_skipped}};
         if (is_accum) {
-            j["time_ms"]["pinhole"] = median(pinhole_ms);
-            j["time_ms"]["views"] = median(views_ms);
-            j["time_ms"]["accumulate"] = median(accum_ms);
             nlohmann::json aj = {{"samples", args.samples},
                                  {"pixel_jitter", args.pixel_jitter},
                                  {"views", accum_stats.views},
@@ -907,10 +895,10 @@ int runRender(const RenderArgs& args) {
     if (!args.depth_out.empty())
         std::printf(" and %s", args.depth_out.c_str());
     if (is_accum)
-        std::printf(" (%ux%u, accum %u views, %.1f ms)\n", frame.width, frame.height,
+        std::printf(" (%ux%u, accum %u views, %.1f ms)\n", view->width, view->height,
                     accum_stats.views, median(totals));
     else
-        std::printf(" (%ux%u, %s, %.1f ms)\n", frame.width, frame.height, args.method.c_str(),
+        std::printf(" (%ux%u, %s, %.1f ms)\n", view->width, view->height, args.method.c_str(),
                     median(totals));
     return 0;
 }

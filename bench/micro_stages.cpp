@@ -6,11 +6,11 @@
 // metrics. Everything runs inline (TaskPool(0)) on one thread at 400x300 from each scene's
 // default camera, so numbers are per-core costs. Run:
 //   build/bench/focal_microbench --benchmark_filter=Binning
-#include "apps/dof_method.h"
 #include "apps/scene_source.h"
 #include "raster/src/binning.h"
 #include "raster/src/geometry.h"
 
+#include <dof/frame_renderer.h>
 #include <dof/gather.h>
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
@@ -27,6 +27,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -168,28 +169,27 @@ void BM_GatherFilter(benchmark::State& state) {
 }
 BENCHMARK(BM_GatherFilter)->Apply(sceneArgs);
 
-// A table method with its default options; its stage times become counters.
+// A method with its default settings through dof::FrameRenderer (kept between iterations, as
+// `focal render --repeat` keeps it); its stage times become counters.
 void methodBench(benchmark::State& state, const std::string& method) {
     const Setup& s = setupFor(sceneName(state.range(0)));
     state.SetLabel(sceneName(state.range(0)));
-    const focal::MethodEntry* entry = nullptr;
-    for (const focal::MethodEntry& m : focal::methodTable())
-        if (m.name == method)
-            entry = &m;
-    FOCAL_CHECK(entry != nullptr);
     raster::TaskPool pool(0);
     raster::Result<dof::LensSampleSet> samples =
         dof::LensSampleSet::create(dof::ApertureShape{}, dof::LensPattern::Hammersley, 32, 0);
     FOCAL_CHECK(samples.ok());
-    raster::RenderOptions options;
+    dof::MethodSettings settings = dof::MultilayerMethod{{}, &*samples};
+    if (method == "multiview")
+        settings = dof::MultiviewMethod{{}, &*samples};
+    const raster::RenderOptions options;
     std::map<std::string, double> stage_sum;
-    focal::MethodBuffers buffers; // kept between iterations, as `focal render --repeat` keeps it
+    dof::FrameRenderer frames(pool);
+    std::vector<float> rgba(size_t(s.view.width) * s.view.height * 4);
+    const dof::FrameImage image{rgba.data(), size_t(s.view.width) * 4, nullptr, 0};
+    dof::FrameReport report;
     for (auto _ : state) {
-        focal::MethodInput in{s.scene, s.view, s.lens, *samples, pool,
-                              options, {},     {},     nullptr,  &buffers};
-        focal::MethodOutput out;
-        FOCAL_CHECK(entry->run(in, out).ok());
-        for (const auto& [stage, ms] : out.stage_ms)
+        FOCAL_CHECK(frames.render(s.scene, s.view, s.lens, options, settings, image, &report).ok());
+        for (const auto& [stage, ms] : report.stage_ms)
             stage_sum[stage] += ms;
     }
     for (const auto& [stage, ms] : stage_sum)
