@@ -82,7 +82,7 @@ Status dumpLayers(const raster::LayeredTarget& layers, const raster::View& view,
             for (int k = 0; k < 4; ++k)
                 color.pixels[p * 4 + size_t(k)] = c[k];
             const float d = depths.load(layers.index(l, p));
-            depth.pixels[p] = d < 1.0f ? raster::distanceFromDepth(view, d) : 0.0f;
+            depth.pixels[p] = d < raster::kFarDepth ? raster::distanceFromDepth(view, d) : 0.0f;
             covered += c.a > 0.0f;
         }
         if (Status s =

@@ -67,7 +67,7 @@ void copyRows(const float* src, uint32_t width, uint32_t height, const FrameImag
                     row * sizeof(float));
 }
 
-// The distance along the view axis of each stored depth D (+inf where D >= 1 when
+// The distance along the view axis of each stored depth D (+inf where D >= kFarDepth when
 // `empty_is_infinite`), into the caller's depth rows.
 void writeDepth(const raster::View& view, const raster::DepthBuffer& depth, bool empty_is_infinite,
                 const FrameImage& image) {
@@ -75,8 +75,9 @@ void writeDepth(const raster::View& view, const raster::DepthBuffer& depth, bool
         float* row = image.depth + size_t(y) * image.depth_stride;
         for (uint32_t x = 0; x < view.width; ++x) {
             const float d = depth.load(size_t(y) * view.width + x);
-            row[x] =
-                empty_is_infinite && !(d < 1.0f) ? INFINITY : raster::distanceFromDepth(view, d);
+            row[x] = empty_is_infinite && !(d < raster::kFarDepth)
+                         ? INFINITY
+                         : raster::distanceFromDepth(view, d);
         }
     }
 }

@@ -103,7 +103,7 @@ Status checkImage(const GatherImage& image) {
 
 float loadDepth(const StoredDepthRef& d, size_t i) {
     return d.format == raster::DepthFormat::Float32 ? d.float32[i]
-                                                    : float(d.unorm16[i]) * (1.0f / 65535.0f);
+                                                    : raster::decodeUnorm16(d.unorm16[i]);
 }
 
 // The coc stage for one pixel (§4.1 then the per-pixel factors of §4.2). Returns false on bad
@@ -115,7 +115,7 @@ struct PixelTerms {
 bool pixelTerms(const GatherImage& image, const CocAffine& ca, const GatherSettings& s, size_t i,
                 PixelTerms& t, bool& bad_depth) {
     const float stored = loadDepth(image.depth, i);
-    if (!(stored >= 0.0f && stored <= 1.0f)) { // also rejects NaN
+    if (!(stored >= raster::kNearDepth && stored <= raster::kFarDepth)) { // also rejects NaN
         bad_depth = true;
         return false;
     }
@@ -223,16 +223,16 @@ StoredDepthRef depthRefOf(const raster::DepthBuffer& depth) {
 }
 
 CocAffine cocAffine(const ThinLens& lens, const raster::View& view) {
-    // Eq. 7 gives z from z'/w'; here D = (z'/w' + 1)/2 of Eq. 4's P, i.e. 1/d = 1/n - D (1/n -
-    // 1/f). Substituted into C(d) = E f_px (1/d_f - 1/d) (Eq. 2 in pixels, lens.h) this is affine
-    // in D: no division per pixel (§5: "the circle of confusion and depth value computations
-    // were combined and scaled to pixels").
+    // Eq. 7 gives z from z'/w'; here D = -(1/d - 1/f) / (1/n - 1/f) (camera.h), i.e. 1/d = 1/f -
+    // D (1/n - 1/f). Substituted into C(d) = E f_px (1/d_f - 1/d) (Eq. 2 in pixels, lens.h) this
+    // is affine in D: no division per pixel (§5: "the circle of confusion and depth value
+    // computations were combined and scaled to pixels").
     const double k = double(lens.aperture_radius) * double(lens.focal_length_px);
     const double inv_n = 1.0 / double(view.znear);
     const double inv_f = view.zfar > 0.0f ? 1.0 / double(view.zfar) : 0.0;
     CocAffine ca;
     ca.a = k * (inv_n - inv_f);
-    ca.b = k * (1.0 / double(lens.focus_distance) - inv_n);
+    ca.b = k * (1.0 / double(lens.focus_distance) - inv_f);
     return ca;
 }
 
@@ -271,7 +271,7 @@ Status badInput(const GatherImage& image, size_t index, bool bad_depth) {
     if (bad_depth)
         return Status::error("gather: stored depth " +
                              std::to_string(loadDepth(image.depth, index)) + where +
-                             " is not in [0, 1]");
+                             " is not in [-1, 0]");
     return Status::error("gather: colour" + where + " is not finite");
 }
 

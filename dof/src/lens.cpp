@@ -70,7 +70,7 @@ raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const r
                              std::to_string(pinhole.height) + " image");
     const float stored = pinhole.depth.load(y * pinhole.width + x);
     const float d = raster::distanceFromDepth(view, stored);
-    if (stored >= 1.0f || !std::isfinite(d) || d <= 0.0f)
+    if (!(stored < raster::kFarDepth) || !std::isfinite(d) || d <= 0.0f)
         return Status::error("--focus-pixel " + std::to_string(x) + "," + std::to_string(y) +
                              " shows only background; there is no depth to focus on");
     return d;

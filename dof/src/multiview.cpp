@@ -25,7 +25,7 @@ double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-// Stored depth of an empty layer texel in the scratch copy: above every real D in [0,1].
+// Stored depth of an empty layer texel in the scratch copy: above every real D in [-1, 0].
 constexpr float kEmptyDepth = 2.0f;
 // Cone coverage at or above this ends the traversal (the cone is fully blocked, §4.4).
 constexpr float kFullCoverage = 0.999f;
@@ -1433,13 +1433,13 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         shader.emplace(*shading.scene, view, shading.simd);
         tr.shader = &*shader;
     }
-    // C as an affine function of stored depth D: 1/d = 1/n - D (1/n - 1/f) (camera.h), so
-    // C = E f_px (1/d_f - 1/n) + E f_px (1/n - 1/f) D (Eq. 3).
+    // C as an affine function of stored depth D: 1/d = 1/f - D (1/n - 1/f) (camera.h), so
+    // C = E f_px (1/d_f - 1/f) + E f_px (1/n - 1/f) D (Eq. 3).
     {
         const double ef = double(lens.aperture_radius) * double(lens.focal_length_px);
         const double inv_n = 1.0 / double(view.znear);
         const double inv_f = view.zfar > 0.0f ? 1.0 / double(view.zfar) : 0.0;
-        tr.coc_a = float(ef * (1.0 / double(lens.focus_distance) - inv_n));
+        tr.coc_a = float(ef * (1.0 / double(lens.focus_distance) - inv_f));
         tr.coc_b = float(ef * (inv_n - inv_f));
     }
     if (std::isfinite(settings.thickness_px) && tr.coc_b != 0.0f)
@@ -1523,8 +1523,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             if (l + 1 == m)
                 seg.t1 = std::max(seg.t1, content_max[l]);
         }
-        seg.t0 = std::clamp(seg.t0, 0.0f, 1.0f);
-        seg.t1 = std::clamp(seg.t1, seg.t0, 1.0f);
+        seg.t0 = std::clamp(seg.t0, raster::kNearDepth, raster::kFarDepth);
+        seg.t1 = std::clamp(seg.t1, seg.t0, raster::kFarDepth);
         seg.own0 = l == 0 ? seg.t0 : raster::depthFromDistance(view, layers.desc.bounds[l]);
         seg.own1 = l + 1 == m ? seg.t1 : raster::depthFromDistance(view, layers.desc.bounds[l + 1]);
         seg.transparent = transparent_content[l] != 0;

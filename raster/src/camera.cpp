@@ -42,26 +42,25 @@ glm::mat4 projectionMatrix(const View& view) {
     p[2][1] = -shift_y;
     p[2][3] = -1.0f; // w_clip = d
     if (view.zfar > 0.0f) {
-        // z_clip = (d - n) * F / (F - n), so z_clip / w_clip = (1/n - 1/d) / (1/n - 1/F).
-        const float k = view.zfar / (view.zfar - n);
+        // z_clip = n (d - F) / (F - n), so z_clip / w_clip = -(1/d - 1/F) / (1/n - 1/F).
+        const float k = n / (view.zfar - n);
         p[2][2] = -k;
-        p[3][2] = -n * k;
+        p[3][2] = -view.zfar * k;
     } else {
-        p[2][2] = -1.0f; // z_clip = d - n: D = 1 - n/d
-        p[3][2] = -n;
+        p[3][2] = -n; // z_clip = -n: D = -n/d, with one rounding (no 1 - n/d cancellation)
     }
     return p;
 }
 
 float depthFromDistance(const View& view, float d) {
     if (view.zfar > 0.0f)
-        return (1.0f / view.znear - 1.0f / d) / (1.0f / view.znear - 1.0f / view.zfar);
-    return 1.0f - view.znear / d;
+        return -(1.0f / d - 1.0f / view.zfar) / (1.0f / view.znear - 1.0f / view.zfar);
+    return -view.znear / d;
 }
 
 float distanceFromDepth(const View& view, float stored_depth) {
     const float inv_far = view.zfar > 0.0f ? 1.0f / view.zfar : 0.0f;
-    const float inv_d = 1.0f / view.znear - stored_depth * (1.0f / view.znear - inv_far);
+    const float inv_d = inv_far - stored_depth * (1.0f / view.znear - inv_far);
     return inv_d > 0.0f ? 1.0f / inv_d : INFINITY;
 }
 

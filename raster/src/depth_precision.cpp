@@ -1,5 +1,6 @@
 #include <raster/depth_precision.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -7,11 +8,11 @@ namespace raster {
 
 namespace {
 
-// The largest stored D that is still below the far value 1, as a distance from 1.
+// The largest stored D that is still below the far value 0, as a distance from 0.
 double lastStepBelowFar(DepthFormat format) {
-    // unorm16: codes are k/65535 and D rounds to nearest, so D >= 1 - 0.5/65535 becomes 65535.
-    // float: the floats below 1 are 2^-24 apart, and D >= 1 - 2^-25 rounds (to even) to 1.
-    return format == DepthFormat::Unorm16 ? 0.5 / 65535.0 : std::ldexp(1.0, -25);
+    // unorm16: codes are (D + 1) 65535 rounded to nearest, so D >= -0.5/65535 becomes 65535.
+    // float: -n/d rounds to -0 only below half the smallest subnormal, 2^-150.
+    return format == DepthFormat::Unorm16 ? 0.5 / 65535.0 : std::ldexp(1.0, -150);
 }
 
 double invFar(const View& view) {
@@ -31,19 +32,20 @@ const char* formatName(DepthFormat f) {
 } // namespace
 
 float farthestStorableDistance(const View& view, DepthFormat format) {
-    // D = (1/n - 1/d) / (1/n - 1/f) (camera.h) reaches 1 - e at 1/d = e/n + (1 - e)/f.
+    // D = -(1/d - 1/f) / (1/n - 1/f) (camera.h) reaches -e at 1/d = e/n + (1 - e)/f.
     const double e = lastStepBelowFar(format);
     return float(1.0 / (e / double(view.znear) + (1.0 - e) * invFar(view)));
 }
 
 float depthResolution(const View& view, DepthFormat format, float d) {
-    // dD/dd = (1/d^2) / (1/n - 1/f); the step of D is 1/65535, or one float ulp of D.
-    const double D = double(depthFromDistance(view, d));
+    // dD/dd = (1/d^2) / (1/n - 1/f); the step of D is 1/65535, or one float ulp of D (below
+    // |D|: the spacing a rounding can land on), which is 2^-24 |D| or finer.
+    const double D = std::fabs(double(depthFromDistance(view, d)));
     double step = 1.0 / 65535.0;
     if (format == DepthFormat::Float32) {
         int exponent = 0;
-        std::frexp(D > 0.0 ? D : 1e-38, &exponent); // D = m 2^exponent, m in [0.5, 1)
-        step = std::ldexp(1.0, exponent - 24);
+        std::frexp(D > 0.0 ? D : 0x1p-149, &exponent); // D = m 2^exponent, m in [0.5, 1)
+        step = std::ldexp(1.0, std::max(exponent - 24, -149));
     }
     const double dd = double(d);
     return float(step * dd * dd * (1.0 / double(view.znear) - invFar(view)));

@@ -20,10 +20,10 @@ enum Plane : uint32_t { kNear, kFar, kLeft, kRight, kBottom, kTop, kPlaneCount }
 
 float planeDistance(const glm::vec4& c, uint32_t plane, float k) {
     switch (plane) {
-    case kNear:
-        return c.z;
-    case kFar:
-        return c.w - c.z;
+    case kNear: // D = z/w >= -1 (camera.h)
+        return c.z + c.w;
+    case kFar: // D <= 0
+        return -c.z;
     case kLeft:
         return c.x + k * c.w;
     case kRight:
@@ -35,7 +35,7 @@ float planeDistance(const glm::vec4& c, uint32_t plane, float k) {
     }
 }
 
-// Bit p set: the vertex is outside plane p of the box |x|,|y| <= k*w, 0 <= z (<= w).
+// Bit p set: the vertex is outside plane p of the box |x|,|y| <= k*w, -w <= z (<= 0).
 uint32_t outcode(const glm::vec4& c, float k, bool finite_far) {
     uint32_t code = 0;
     for (uint32_t p = 0; p < kPlaneCount; ++p) {

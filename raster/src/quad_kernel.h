@@ -6,6 +6,8 @@
 // (tests/unit/raster/simd_test.cpp).
 #pragma once
 
+#include <raster/storage.h>
+
 #include <cstdint>
 
 namespace raster {
@@ -28,7 +30,7 @@ struct QuadOutput {
     float lambda[3][kQuadLanes]; // screen-space barycentrics
     float persp[3][kQuadLanes];  // perspective-correct barycentrics
     float distance[kQuadLanes];  // view distance d = w
-    float z[kQuadLanes];         // stored depth D, clamped to [0, 1]
+    float z[kQuadLanes];         // stored depth D, clamped to [-1, 0]
 };
 
 using QuadKernel = void (*)(const QuadInput&, QuadOutput&);

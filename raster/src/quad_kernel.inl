@@ -41,6 +41,6 @@ void FOCAL_QUAD_KERNEL_NAME(const QuadInput& in, QuadOutput& out) {
         out.persp[1][l] = q1 * inv;
         out.persp[2][l] = q2 * inv;
         out.distance[l] = inv;
-        out.z[l] = z < 0.0f ? 0.0f : (z > 1.0f ? 1.0f : z);
+        out.z[l] = z < kNearDepth ? kNearDepth : (z > kFarDepth ? kFarDepth : z);
     }
 }

@@ -10,10 +10,10 @@ void DepthBuffer::resize(DepthFormat depth_format, uint32_t w, uint32_t h) {
     height = h;
     const size_t n = size_t(w) * h;
     if (format == DepthFormat::Float32) {
-        float32.assign(n, 1.0f);
+        float32.assign(n, kFarDepth);
         unorm16.clear();
     } else {
-        unorm16.assign(n, uint16_t(65535));
+        unorm16.assign(n, encodeUnorm16(kFarDepth));
         float32.clear();
     }
 }

@@ -34,7 +34,7 @@ struct TileCounters {
 
 // A shaded fragment as the output merger sees it.
 struct Fragment {
-    float z = 1.0f;        // stored depth D (camera.h)
+    float z = kFarDepth;   // stored depth D (camera.h)
     float distance = 0.0f; // view distance d
     glm::vec4 color{0.0f}; // linear RGB and opacity (1 for OPAQUE and MASK)
     bool blend = false;    // BLEND material: composite with "over", no depth write

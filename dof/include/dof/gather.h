@@ -27,11 +27,11 @@
 
 namespace dof {
 
-// A read-only view of a stored depth buffer: D in [0,1] (camera.h), one value per pixel, rows
+// A read-only view of a stored depth buffer: D in [-1, 0] (camera.h), one value per pixel, rows
 // top first, in the format the frame was rendered with.
 struct StoredDepthRef {
     raster::DepthFormat format = raster::DepthFormat::Float32;
-    const uint16_t* unorm16 = nullptr; // format == Unorm16: D = value / 65535
+    const uint16_t* unorm16 = nullptr; // format == Unorm16: D = value / 65535 - 1
     const float* float32 = nullptr;    // format == Float32
 };
 
@@ -46,14 +46,14 @@ struct GatherImage {
     uint32_t height = 0;
 };
 
-// §4.1 rewritten for focal: the stored depth is D = (1/n - 1/d) / (1/n - 1/f) (the window-space
-// z'/w' of Eq. 4 mapped to [0,1]), so 1/d = 1/n - D (1/n - 1/f) and the CoC of Eq. 2,
-// C(d) = E f_px (1/d_f - 1/d), is affine in D:
-//   C = a D + b,   a = E f_px (1/n - 1/f),   b = E f_px (1/d_f - 1/n)      (1/f = 0 if f = inf).
+// §4.1 rewritten for focal: the stored depth is D = -(1/d - 1/f) / (1/n - 1/f) (the window-space
+// z'/w' of Eq. 4 mapped to [-1, 0], reversed-Z with the sign flipped), so 1/d = 1/f - D (1/n - 1/f)
+// and the CoC of Eq. 2, C(d) = E f_px (1/d_f - 1/d), is affine in D:
+//   C = a D + b,   a = E f_px (1/n - 1/f),   b = E f_px (1/d_f - 1/f)      (1/f = 0 if f = inf).
 // Computed in double; C is then evaluated per pixel as a*D + b in double and rounded to float.
 struct CocAffine {
     double a = 0.0; // pixels per unit of stored depth
-    double b = 0.0; // pixels (the CoC at D = 0, i.e. on the near plane)
+    double b = 0.0; // pixels (the CoC at D = 0, i.e. on the far plane or at infinity)
 };
 CocAffine cocAffine(const ThinLens& lens, const raster::View& view);
 
@@ -115,7 +115,7 @@ struct GatherScratch {
 // Runs the filter. `out_rgba` is resized to width*height*4; `out_coc`, when given, receives the
 // signed CoC C per pixel (pixels). `pool` may be null (inline). Fails, naming the problem, on
 // an invalid lens or settings, a null/empty image, non-finite colour, or stored depth that is
-// not finite or outside [0,1] (the first offending pixel in row order).
+// not finite or outside [-1, 0] (the first offending pixel in row order).
 raster::Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens,
                                    const raster::View& view, const GatherSettings& settings,
                                    std::vector<float>& out_rgba,

@@ -3,8 +3,12 @@
 // the accumulation reference derives sheared views from it (lens_offset, focus_distance).
 //
 // Depth convention: d is the distance along the view axis (camera space -z). The depth buffer
-// stores D = (1/n - 1/d) / (1/n - 1/f) in [0,1] (D3D-style z/w; f = inf gives D = 1 - n/d),
-// which is affine in 1/d, like the circle of confusion.
+// stores D = -(1/d - 1/f) / (1/n - 1/f) in [-1, 0]: -1 at the near plane, 0 at the far plane
+// (f = inf gives D = -n/d). D is affine in 1/d, like the circle of confusion, and grows with d
+// (the depth test is LESS, the nearest depth the smallest). It is reversed-Z with the sign
+// flipped: the far distances sit next to 0, where a float is densest, so float D resolves every
+// distance to about 2^-24 of itself instead of rounding far surfaces onto the far plane (the
+// classic 1 - n/d does that from about n * 2^24 on). docs/targets.md, "Depth precision".
 #pragma once
 
 #include <raster/scene.h>

@@ -13,9 +13,10 @@
 
 namespace raster {
 
-// The distance from which on every depth stores as the far value D = 1 (the clear value), so
-// the strict depth test drops the surface: unorm16 rounds D >= 1 - 2^-17 up to 65535, and a
-// float D >= 1 - 2^-25 rounds to 1. With a finite far plane f it lies just before f.
+// The distance from which on every depth stores as the far value D = 0 (the clear value), so
+// the strict depth test drops the surface: unorm16 rounds D >= -2^-17 up to code 65535; a float
+// D = -n/d only reaches 0 by underflow, beyond n * 2^149 (infinite as a float). With a finite
+// far plane f it lies just before f.
 float farthestStorableDistance(const View& view, DepthFormat format);
 
 // The step between neighbouring stored values at distance d, in world units: surfaces closer

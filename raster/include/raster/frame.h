@@ -31,15 +31,15 @@ inline uint64_t frameBytes(uint32_t width, uint32_t height, DepthFormat depth_fo
 }
 
 // Calls fn(stored D) for every visible surface depth of the frame: the opaque depth and the
-// nearest BLEND surface of each covered pixel (D < 1), in pixel order.
+// nearest BLEND surface of each covered pixel (D < kFarDepth), in pixel order.
 template <class Fn> void forEachVisibleDepth(const Frame& frame, Fn&& fn) {
     const size_t pixels = size_t(frame.width) * frame.height;
     const bool transparent = frame.transparent_depth.bytes() > 0;
     for (size_t i = 0; i < pixels; ++i) {
-        if (const float d = frame.depth.load(i); d < 1.0f)
+        if (const float d = frame.depth.load(i); d < kFarDepth)
             fn(d);
         if (transparent)
-            if (const float d = frame.transparent_depth.load(i); d < 1.0f)
+            if (const float d = frame.transparent_depth.load(i); d < kFarDepth)
                 fn(d);
     }
 }

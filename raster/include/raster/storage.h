@@ -12,8 +12,12 @@
 
 namespace raster {
 
-// 16-bit unorm or 32-bit float storage of D in [0,1] (see camera.h).
+// 16-bit unorm or 32-bit float storage of D in [-1, 0] (see camera.h).
 enum class DepthFormat : uint8_t { Unorm16, Float32 };
+
+// Stored depth at the near plane and at the far plane (also the clear value: nothing drawn).
+constexpr float kNearDepth = -1.0f;
+constexpr float kFarDepth = 0.0f;
 // RGBA colour storage.
 enum class ColorFormat : uint8_t { Half, Float32 };
 
@@ -25,10 +29,16 @@ constexpr uint32_t bytesPerColor(ColorFormat f) {
     return f == ColorFormat::Half ? 8 : 16;
 }
 
-// Round-to-nearest unorm16 encoding of D in [0,1].
+// Round-to-nearest unorm16 encoding of D in [-1, 0] as code (D + 1) * 65535: the far plane is
+// 65535. A fixed-point code gains nothing from reversing (its steps are uniform either way).
 inline uint16_t encodeUnorm16(float d) {
-    const float clamped = d < 0.0f ? 0.0f : (d > 1.0f ? 1.0f : d);
+    const float u = d + 1.0f;
+    const float clamped = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
     return uint16_t(clamped * 65535.0f + 0.5f);
+}
+// Exact at the far plane: code 65535 decodes to 0 (kFarDepth).
+inline float decodeUnorm16(uint16_t code) {
+    return float(int32_t(code) - 65535) * (1.0f / 65535.0f);
 }
 
 struct DepthBuffer {
@@ -38,15 +48,15 @@ struct DepthBuffer {
     std::vector<uint16_t> unorm16; // used when format == Unorm16
     std::vector<float> float32;    // used when format == Float32
 
-    // Resizes and clears to the far value (D = 1).
+    // Resizes and clears to the far value kFarDepth.
     void resize(DepthFormat depth_format, uint32_t w, uint32_t h);
-    // D at pixel index i, as a float in [0,1].
+    // D at pixel index i, as a float in [-1, 0].
     float load(size_t i) const {
-        return format == DepthFormat::Float32 ? float32[i] : float(unorm16[i]) * (1.0f / 65535.0f);
+        return format == DepthFormat::Float32 ? float32[i] : decodeUnorm16(unorm16[i]);
     }
     // The value D would have once stored (the depth test compares stored values).
     float quantize(float d) const {
-        return format == DepthFormat::Float32 ? d : float(encodeUnorm16(d)) * (1.0f / 65535.0f);
+        return format == DepthFormat::Float32 ? d : decodeUnorm16(encodeUnorm16(d));
     }
     void store(size_t i, float d) {
         if (format == DepthFormat::Float32)

@@ -42,7 +42,8 @@ TEST(MultiviewScenes, RailingBackgroundShowsThroughNearBars) {
     size_t count = 0;
     for (size_t i = 0; i < bars.size(); ++i) {
         const float d = pinhole.depth.load(i);
-        if (d < 1.0f && raster::distanceFromDepth(c.view, d) < 0.6f * c.lens.focus_distance)
+        if (d < raster::kFarDepth &&
+            raster::distanceFromDepth(c.view, d) < 0.6f * c.lens.focus_distance)
             bars[i] = 1, ++count;
     }
     ASSERT_GT(count, 500u);

@@ -77,10 +77,10 @@ TEST(Gather, CocIsAffineInTheStoredDepth) {
             EXPECT_NEAR(c, double(slow), 1e-3 * std::max(1.0, std::fabs(double(slow))))
                 << "d = " << d << " far = " << zfar;
         }
-        // D = 0 is the near plane, D = 1 the far plane (or infinity).
-        EXPECT_NEAR(ca.b, double(dof::cocRadiusPx(lens, view.znear)), 1e-3);
+        // D = -1 is the near plane, D = 0 the far plane (or infinity).
+        EXPECT_NEAR(ca.b - ca.a, double(dof::cocRadiusPx(lens, view.znear)), 1e-3);
         const float far_c = dof::cocRadiusPx(lens, zfar > 0.0f ? zfar : INFINITY);
-        EXPECT_NEAR(ca.a + ca.b, double(far_c), 1e-3);
+        EXPECT_NEAR(ca.b, double(far_c), 1e-3);
     }
 }
 
@@ -340,10 +340,10 @@ TEST(Gather, RejectsBadInputWithTheOptionName) {
     f.depth.float32[9 * 32 + 1] = NAN;
     std::string m = message({});
     EXPECT_NE(m.find("(7, 5)"), std::string::npos) << m;
-    f.depth.float32[5 * 32 + 7] = 0.5f;
+    f.depth.float32[5 * 32 + 7] = -0.5f;
     m = message({});
     EXPECT_NE(m.find("(1, 9)"), std::string::npos) << m;
-    f.depth.float32[9 * 32 + 1] = 0.5f;
+    f.depth.float32[9 * 32 + 1] = -0.5f;
     f.color[4 * 33 + 2] = INFINITY;
     m = message({});
     EXPECT_NE(m.find("colour"), std::string::npos) << m;

@@ -25,12 +25,15 @@ TEST(DepthPrecision, FarthestStorableDistanceIsWhereTheFarValueTakesOver) {
     // Just inside it still stores below 65535, just beyond it stores the far value.
     EXPECT_LT(raster::encodeUnorm16(raster::depthFromDistance(v, 0.99f * unorm)), 65535);
     EXPECT_EQ(raster::encodeUnorm16(raster::depthFromDistance(v, 1.01f * unorm)), 65535);
-    const float f32 = raster::farthestStorableDistance(v, DepthFormat::Float32);
-    EXPECT_LT(raster::depthFromDistance(v, 0.9f * f32), 1.0f);
-    EXPECT_EQ(raster::depthFromDistance(v, 1.1f * f32), 1.0f);
-    // With a finite far plane, only the last half step before it is lost (0.76% of 100 here).
+    // Float D = -n/d reaches the far value 0 only by underflow: never, for a float distance.
+    EXPECT_TRUE(std::isinf(raster::farthestStorableDistance(v, DepthFormat::Float32)));
+    EXPECT_LT(raster::depthFromDistance(v, 3e38f), raster::kFarDepth);
+    // With a finite far plane, only the last half step before it is lost (0.76% of 100 here);
+    // float loses next to nothing.
     EXPECT_NEAR(raster::farthestStorableDistance(viewWithNear(0.1f, 100.0f), DepthFormat::Unorm16),
                 99.24f, 0.01f);
+    EXPECT_NEAR(raster::farthestStorableDistance(viewWithNear(0.1f, 100.0f), DepthFormat::Float32),
+                100.0f, 1e-4f);
 }
 
 TEST(DepthPrecision, ResolutionGrowsWithTheSquareOfDistance) {
@@ -38,9 +41,13 @@ TEST(DepthPrecision, ResolutionGrowsWithTheSquareOfDistance) {
     const float at10 = raster::depthResolution(v, DepthFormat::Unorm16, 10.0f);
     EXPECT_NEAR(at10, 10.0f * 10.0f / (0.1f * 65535.0f), 1e-5f);
     EXPECT_NEAR(raster::depthResolution(v, DepthFormat::Unorm16, 20.0f), 4.0f * at10, 1e-4f);
-    // float stores D near 1 with 2^-24 steps: 256 times finer than unorm16 there.
-    EXPECT_NEAR(raster::depthResolution(v, DepthFormat::Float32, 10.0f) * 256.0f, at10,
-                0.01f * at10);
+    // float D = -n/d keeps 24 bits at every distance: d 2^-24 up to d 2^-23, whatever n.
+    for (const float near : {1e-6f, 0.1f})
+        for (const float d : {10.0f, 1e4f, 1e7f}) {
+            const float step = raster::depthResolution(viewWithNear(near), DepthFormat::Float32, d);
+            EXPECT_GE(step, std::ldexp(d, -24) * 0.999f) << near << " " << d;
+            EXPECT_LE(step, std::ldexp(d, -23) * 1.001f) << near << " " << d;
+        }
 }
 
 TEST(DepthPrecision, ProblemNamesTheNumbers) {
@@ -51,13 +58,11 @@ TEST(DepthPrecision, ProblemNamesTheNumbers) {
     EXPECT_EQ(*problem, "unorm16 depth with near 1e-05 stores every distance beyond 1.31 as the "
                         "far plane, but the scene reaches 25: surfaces beyond 1.31 are not drawn "
                         "(raise --near or use float32 depth)");
-    // Float depth (D = 1 - n/d, not reversed) keeps them, but only 3.7 units apart at 25.
-    const auto f32 = raster::depthPrecisionProblem(viewWithNear(1e-5f), DepthFormat::Float32, 2.0f,
-                                                   25.0f, "depth");
-    ASSERT_TRUE(f32.has_value());
-    EXPECT_NE(f32->find("float32 depth with near 1e-05 resolves distances near 25 only to 3.7"),
-              std::string::npos)
-        << *f32;
+    // Float depth (D = -n/d, reversed-Z) keeps them, 24 bits apart at any distance.
+    EXPECT_FALSE(raster::depthPrecisionProblem(viewWithNear(1e-5f), DepthFormat::Float32, 2.0f,
+                                               25.0f, "depth"));
+    EXPECT_FALSE(raster::depthPrecisionProblem(viewWithNear(1e-6f), DepthFormat::Float32, 1e-6f,
+                                               1e8f, "depth"));
     // The usual near planes are fine with either format.
     EXPECT_FALSE(raster::depthPrecisionProblem(viewWithNear(1e-3f), DepthFormat::Float32, 2.0f,
                                                25.0f, "depth"));

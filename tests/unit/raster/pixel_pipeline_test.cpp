@@ -22,15 +22,18 @@ std::vector<glm::vec3> quadAt(float depth, float half) {
 }
 const std::vector<uint32_t> kQuad = {0, 1, 2, 0, 2, 3};
 
-raster::Frame renderTwoPlanes(float first_depth, float second_depth, DepthFormat format) {
+// A red plane at first_depth drawn before a green one at second_depth, both covering the
+// centre pixel.
+raster::Frame renderTwoPlanes(float first_depth, float second_depth, DepthFormat format,
+                              float znear = 0.5f, float zfar = 256.0f) {
     raster::Scene s;
     const int32_t red = addMaterial(s, flatMaterial({1, 0, 0, 1}));
     const int32_t green = addMaterial(s, flatMaterial({0, 1, 0, 1}));
     addMesh(s, quadAt(first_depth, 40.0f), kQuad, red);
     addMesh(s, quadAt(second_depth, 40.0f), kQuad, green);
     raster::View v = pixelView(kSize, kSize, kDist);
-    v.znear = 0.5f;
-    v.zfar = 256.0f;
+    v.znear = znear;
+    v.zfar = zfar;
     raster::RenderOptions o;
     o.depth_format = format;
     return render(s, v, o);
@@ -50,6 +53,25 @@ TEST(Depth, SixteenBitStorageCannotSeparateCloseSurfaces) {
     EXPECT_EQ(pixel(renderTwoPlanes(100.0f, 99.99f, DepthFormat::Unorm16), 32, 32).r, 1.0f);
 }
 
+TEST(Depth, FloatDepthKeepsFarSurfacesApartWithATinyNearPlane) {
+    // Near 1e-5 and no far plane: D = -n/d is about -1e-8 at d = 1000, where float still has 24
+    // bits. The classic D = 1 - n/d rounded both planes onto the far value 1 and drew nothing.
+    for (const float gap : {1.0f, 0.01f}) {
+        const raster::Frame a =
+            renderTwoPlanes(1000.0f, 1000.0f - gap, DepthFormat::Float32, 1e-5f, 0.0f);
+        const raster::Frame b =
+            renderTwoPlanes(1000.0f - gap, 1000.0f, DepthFormat::Float32, 1e-5f, 0.0f);
+        EXPECT_EQ(pixel(a, 32, 32), glm::vec4(0, 1, 0, 1)) << "gap " << gap;
+        EXPECT_EQ(pixel(b, 32, 32), glm::vec4(1, 0, 0, 1)) << "gap " << gap;
+    }
+    // Far beyond any scene, surfaces still store below the far value.
+    raster::View v = pixelView(kSize, kSize, kDist);
+    v.znear = 1e-5f;
+    v.zfar = 0.0f;
+    EXPECT_LT(raster::depthFromDistance(v, 1e30f), raster::kFarDepth);
+    EXPECT_NEAR(raster::distanceFromDepth(v, raster::depthFromDistance(v, 1e6f)), 1e6f, 1.0f);
+}
+
 TEST(Depth, StoredValuesMatchTheProjection) {
     for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm16}) {
         const raster::Frame f = renderTwoPlanes(100.0f, 200.0f, format);
@@ -62,7 +84,7 @@ TEST(Depth, StoredValuesMatchTheProjection) {
         EXPECT_NEAR(stored, expected, tolerance);
         EXPECT_NEAR(raster::distanceFromDepth(v, stored), 100.0f,
                     format == DepthFormat::Float32 ? 1e-3f : 0.2f);
-        EXPECT_EQ(f.depth.load(0), 1.0f); // background keeps the clear value
+        EXPECT_EQ(f.depth.load(0), raster::kFarDepth); // background keeps the clear value
     }
 }
 
@@ -103,8 +125,8 @@ TEST(Alpha, MaskDiscardsBelowTheCutoffAndIsOpaqueAbove) {
     const raster::Frame f = render(s, pixelView(kSize, kSize, kDist));
     EXPECT_EQ(pixel(f, 10, 32), glm::vec4(0, 0, 0, 1)); // alpha ~0.16: discarded
     EXPECT_EQ(pixel(f, 50, 32), glm::vec4(0, 0, 1, 1)); // alpha ~0.79: opaque, full alpha
-    EXPECT_EQ(f.depth.load(32 * kSize + 10), 1.0f);
-    EXPECT_LT(f.depth.load(32 * kSize + 50), 1.0f);
+    EXPECT_EQ(f.depth.load(32 * kSize + 10), raster::kFarDepth);
+    EXPECT_LT(f.depth.load(32 * kSize + 50), raster::kFarDepth);
 }
 
 TEST(Alpha, BlendIsOverInPrimitiveOrderAfterOpaqueWithoutDepthWrite) {

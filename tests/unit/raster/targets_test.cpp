@@ -107,7 +107,7 @@ TEST(LayeredTarget, ExactRoutingEqualsRendersClippedToEachLayer) {
         const raster::Frame ref = render(s, clipped);
         size_t mismatched = 0, covered = 0;
         for (size_t p = 0; p < t.pixelCount(); ++p) {
-            const bool in_ref = ref.depth.load(p) < 1.0f;
+            const bool in_ref = ref.depth.load(p) < raster::kFarDepth;
             const glm::vec4 c = t.color.load(t.index(l, p));
             covered += in_ref;
             if (in_ref != (c.a > 0.0f)) {
@@ -149,7 +149,8 @@ TEST(LayeredTarget, PaperRoutingDiffersOnlyWhereTrianglesCrossBounds) {
                 paper.depth.load(i) == exact.depth.load(i))
                 continue;
             ++differing;
-            EXPECT_LT(footprint.depth.load(p), 1.0f) << "layer " << l << " pixel " << p;
+            EXPECT_LT(footprint.depth.load(p), raster::kFarDepth)
+                << "layer " << l << " pixel " << p;
         }
     EXPECT_GT(differing, 0u); // the crossing quad does land in other layers
 }
@@ -261,7 +262,7 @@ TEST(FragmentLists, EqualDepthPeeling) {
                 EXPECT_EQ(fl.color.load(i),
                           pixel(peeled, uint32_t(p % v.width), uint32_t(p / v.width)));
             } else {
-                EXPECT_EQ(peeled.depth.load(p), 1.0f) << "peel " << k << " px " << p;
+                EXPECT_EQ(peeled.depth.load(p), raster::kFarDepth) << "peel " << k << " px " << p;
             }
         }
         raster::RenderOptions o;
