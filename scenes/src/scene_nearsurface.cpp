@@ -63,7 +63,7 @@ raster::Scene makeNearSurfaceScene() {
         directionalLight("fill", {-0.5f, 0.3f, -0.8f}, {0.7f, 0.8f, 1.0f}, 0.7f));
 
     // Lens: the wall is sharp at 1.2 m; E = 11 mm gives the part's near end a CoC of -40 px and
-    // its far end -17 px (C(d) = E f_px (1/d_f - 1/d), DESIGN.md "The lens").
+    // its far end -17 px (C(d) = E f_px (1/d_f - 1/d), docs/dof/lens.md; Lee et al. 2009 Eq. 3).
     scene.lens = raster::LensHint{0.011f, viewDepth(scene.cameras[0], {0.0f, 0.0f, wall_z})};
     return scene;
 }

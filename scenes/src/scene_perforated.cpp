@@ -74,7 +74,7 @@ raster::Scene makePerforatedScene() {
         directionalLight("fill", {-0.5f, 0.2f, -0.85f}, {0.7f, 0.8f, 1.0f}, 0.8f));
 
     // Lens: the middle gear is sharp at 1.2 m; E = 3 cm gives the grill a CoC of about -25 px
-    // (C(d) = E f_px (1/d_f - 1/d), DESIGN.md "The lens").
+    // (C(d) = E f_px (1/d_f - 1/d), docs/dof/lens.md; Lee et al. 2009 Eq. 3).
     scene.lens = raster::LensHint{0.03f, 1.2f};
     return scene;
 }

@@ -74,7 +74,7 @@ raster::Scene makeRailingScene() {
         directionalLight("fill", {-0.4f, -0.3f, -0.85f}, {0.7f, 0.8f, 1.0f}, 0.8f));
 
     // Lens: the sign is sharp; E = 3 cm gives the bars a CoC of ~-25 px (C(d) = E f_px
-    // (1/d_f - 1/d), DESIGN.md "The lens").
+    // (1/d_f - 1/d), docs/dof/lens.md; Lee et al. 2009 Eq. 3).
     scene.lens = raster::LensHint{0.03f, viewDepth(scene.cameras[0], {0.0f, 1.2f, sign_z})};
     return scene;
 }

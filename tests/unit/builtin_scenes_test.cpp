@@ -335,7 +335,7 @@ TEST(BuiltinScenes, RailingBarsAreNearAndTextIsAtTheFocusDistance) {
     const auto [text_near, text_far] = depthRange(scene, "text");
     EXPECT_NEAR(text_near, focus, 1e-3f * focus);
     EXPECT_NEAR(text_far, focus, 1e-3f * focus);
-    // The bars are thinner than their blur: CoC radius (DESIGN.md) exceeds the bar width in px.
+    // The bars are thinner than their blur: |C(d)| (docs/dof/lens.md) exceeds the bar width in px.
     const float f_px = 300.0f / std::tan(0.5f * scene.cameras[0].yfov);
     const float coc = scene.lens->aperture_radius * f_px * (1.0f / bars_near - 1.0f / focus);
     EXPECT_GT(coc, 0.012f * f_px / bars_near);

@@ -1,5 +1,6 @@
-// Counter-based hashing: the only source of "randomness" in focal (DESIGN.md, determinism). A
-// value is a pure function of its inputs (pixel, sample index, seed, ...), never of shared state.
+// Counter-based hashing: the only source of "randomness" in focal (docs/architecture.md, "The
+// determinism contract"). A value is a pure function of its inputs (pixel, sample index, seed,
+// ...), never of shared state.
 #pragma once
 
 #include <cstdint>

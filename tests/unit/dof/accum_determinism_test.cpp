@@ -1,5 +1,6 @@
-// Determinism of accum (DESIGN.md, "Determinism contract"): the same bytes for every thread
-// count and tile size, on a small scene with depth variation, pixel jitter and a polygon lens.
+// Determinism of accum (docs/architecture.md, "The determinism contract"): the same bytes for
+// every thread count and tile size, on a small scene with depth variation, pixel jitter and a
+// polygon lens.
 #include "dof_test_util.h"
 
 #include <gtest/gtest.h>
