@@ -191,20 +191,6 @@ const char* apertureKindName(dof::ApertureKind k) {
                                            : "circle";
 }
 
-std::vector<std::string> methodNames() {
-    std::vector<std::string> names = {"pinhole", "accum"};
-    for (const MethodEntry& m : methodTable())
-        names.push_back(m.name);
-    return names;
-}
-
-const MethodEntry* findMethod(const std::string& name) {
-    for (const MethodEntry& m : methodTable())
-        if (m.name == name)
-            return &m;
-    return nullptr;
-}
-
 // Progress bar on stderr, only when stderr is a terminal.
 class ProgressBar {
 public:
