@@ -32,6 +32,80 @@ bool setsLens(const LensRequest& r) {
     return r.aperture_radius || r.fstop || r.focus_distance || r.focus_pixel;
 }
 
+// The aperture radius: the request's, its f-stop's, the scene's hint's, else 0.
+float resolveAperture(const LensRequest& request, const raster::Scene& scene,
+                      ApertureSource& source) {
+    if (request.aperture_radius) {
+        source = ApertureSource::Request;
+        return *request.aperture_radius;
+    }
+    if (request.fstop) {
+        source = ApertureSource::FStop;
+        return apertureRadiusFromFStop(*request.focal_length_mm, *request.fstop);
+    }
+    if (scene.lens) {
+        source = ApertureSource::Scene;
+        return scene.lens->aperture_radius;
+    }
+    source = ApertureSource::Default;
+    return 0.0f;
+}
+
+// The depth the pinhole frame shows at the focus pixel (else the image centre); none where the
+// centre shows background. Times the pinhole in r.ms_focus.
+raster::Result<std::optional<float>> pinholeFocus(const LensRequest& request,
+                                                  const PinholeSource& pinhole, ResolvedLens& r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    raster::Result<const raster::Frame*> frame = pinhole(r.view);
+    if (!frame.ok())
+        return frame.status();
+    r.ms_focus =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const glm::uvec2 at =
+        request.focus_pixel.value_or(glm::uvec2(r.view.width / 2, r.view.height / 2));
+    raster::Result<float> d = focusDistanceAtPixel(**frame, r.view, at.x, at.y);
+    if (request.focus_pixel && !d.ok())
+        return d.status();
+    return d.ok() ? std::optional<float>(*d) : std::nullopt;
+}
+
+// The focus distance, in the order of the header's precedence; r.focus_source says which.
+raster::Result<float> resolveFocus(const LensRequest& request, const raster::Scene& scene,
+                                   const PinholeSource& pinhole, ResolvedLens& r) {
+    if (request.focus_distance) {
+        r.focus_source = FocusSource::Request;
+        return *request.focus_distance;
+    }
+    // The pinhole frame is needed for a focus pixel, and for autofocus when nothing else names
+    // a focus distance; it does not depend on the lens.
+    if (request.focus_pixel || (!request.pinhole_image && !request.view_focus && !scene.lens)) {
+        // Without a frame (a dry run) the bounds stand in for it.
+        std::optional<float> seen;
+        if (pinhole) {
+            raster::Result<std::optional<float>> d = pinholeFocus(request, pinhole, r);
+            if (!d.ok())
+                return d.status();
+            seen = *d;
+        }
+        if (seen) {
+            r.focus_source = request.focus_pixel ? FocusSource::FocusPixel : FocusSource::Autofocus;
+            return *seen;
+        }
+        if (const std::optional<float> bounds_d = boundsFocusDistance(scene, r.view)) {
+            r.focus_source = FocusSource::Bounds;
+            return *bounds_d;
+        }
+    } else if (request.view_focus) {
+        r.focus_source = FocusSource::ViewFocus;
+        return r.view.focus_distance;
+    } else if (scene.lens) {
+        r.focus_source = FocusSource::Scene;
+        return scene.lens->focus_distance;
+    }
+    r.focus_source = FocusSource::ViewDefault;
+    return r.view.focus_distance;
+}
+
 } // namespace
 
 Status validate(const LensRequest& request) {
@@ -67,65 +141,13 @@ raster::Result<ResolvedLens> resolveLens(const LensRequest& request, const raste
         return s;
     ResolvedLens r;
     r.view = photographicView(view, request);
-
-    // Aperture.
-    float aperture_radius = 0.0f;
-    if (request.aperture_radius) {
-        aperture_radius = *request.aperture_radius;
-        r.aperture_source = ApertureSource::Request;
-    } else if (request.fstop) {
-        aperture_radius = apertureRadiusFromFStop(*request.focal_length_mm, *request.fstop);
-        r.aperture_source = ApertureSource::FStop;
-    } else if (scene.lens) {
-        aperture_radius = scene.lens->aperture_radius;
-        r.aperture_source = ApertureSource::Scene;
-    }
-
-    // Focus distance. The pinhole frame is needed for a focus pixel, and for autofocus when
-    // nothing else names a focus distance; it does not depend on the lens.
-    float focus_distance = r.view.focus_distance;
-    const bool wants_pinhole =
-        request.focus_pixel || (!request.pinhole_image && !request.view_focus && !scene.lens);
-    if (request.focus_distance) {
-        focus_distance = *request.focus_distance;
-        r.focus_source = FocusSource::Request;
-    } else if (wants_pinhole) {
-        // The depth the pinhole frame shows there; without a frame (a dry run) the bounds stand
-        // in for it.
-        std::optional<float> seen;
-        if (pinhole) {
-            const auto t0 = std::chrono::steady_clock::now();
-            raster::Result<const raster::Frame*> frame = pinhole(r.view);
-            if (!frame.ok())
-                return frame.status();
-            r.ms_focus =
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count();
-            const glm::uvec2 at =
-                request.focus_pixel.value_or(glm::uvec2(r.view.width / 2, r.view.height / 2));
-            raster::Result<float> d = focusDistanceAtPixel(**frame, r.view, at.x, at.y);
-            if (request.focus_pixel && !d.ok())
-                return d.status();
-            if (d.ok())
-                seen = *d;
-        }
-        if (seen) {
-            focus_distance = *seen;
-            r.focus_source = request.focus_pixel ? FocusSource::FocusPixel : FocusSource::Autofocus;
-        } else if (const std::optional<float> bounds_d = boundsFocusDistance(scene, r.view)) {
-            focus_distance = *bounds_d;
-            r.focus_source = FocusSource::Bounds;
-        }
-    } else if (request.view_focus) {
-        r.focus_source = FocusSource::ViewFocus;
-    } else if (scene.lens) {
-        focus_distance = scene.lens->focus_distance;
-        r.focus_source = FocusSource::Scene;
-    }
-
+    const float aperture_radius = resolveAperture(request, scene, r.aperture_source);
+    raster::Result<float> focus_distance = resolveFocus(request, scene, pinhole, r);
+    if (!focus_distance.ok())
+        return focus_distance.status();
     // The lens owns the focus distance; the view's copy is derived from it here and nowhere else.
-    r.lens = makeThinLens(r.view, aperture_radius, focus_distance);
-    r.view.focus_distance = focus_distance;
+    r.lens = makeThinLens(r.view, aperture_radius, *focus_distance);
+    r.view.focus_distance = *focus_distance;
     if (!request.pinhole_image || setsLens(request))
         if (Status s = validate(r.lens, r.view); !s.ok())
             return s;
