@@ -66,4 +66,10 @@ struct MethodEntry {
 // The methods beyond pinhole and accum, in a fixed order (apps/methods.cpp).
 std::vector<MethodEntry>& methodTable();
 
+// Every `--method` name: pinhole and accum, then the table's methods in order.
+std::vector<std::string> methodNames();
+
+// The table's entry for `name`; null for pinhole, accum and unknown names.
+const MethodEntry* findMethod(const std::string& name);
+
 } // namespace focal

@@ -17,4 +17,18 @@ std::vector<MethodEntry>& methodTable() {
     return entries;
 }
 
+std::vector<std::string> methodNames() {
+    std::vector<std::string> names = {"pinhole", "accum"};
+    for (const MethodEntry& m : methodTable())
+        names.push_back(m.name);
+    return names;
+}
+
+const MethodEntry* findMethod(const std::string& name) {
+    for (const MethodEntry& m : methodTable())
+        if (m.name == name)
+            return &m;
+    return nullptr;
+}
+
 } // namespace focal

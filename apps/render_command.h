@@ -1,4 +1,7 @@
-// `focal render`: options, and the render job they describe.
+// `focal render`: its options, and the command that renders the frame they describe. The options
+// are registered in render_options.cpp, turned into the library's requests (view, raster options,
+// lens request) in render_request.h, rendered by dof::FrameRenderer in render_command.cpp, and
+// reported by render_stats.h (--stats) and render_dumps.h (--dump-layers, --dump-fragments).
 #pragma once
 
 #include <raster/renderer.h>
@@ -31,8 +34,8 @@ struct RenderArgs {
     std::string shading = "material";
     std::string texture_filter = "sampler";
 
-    // Lens (dof/lens.h). Unset values come from the scene's LensHint, then the defaults
-    // documented in docs/dof/lens.md.
+    // Lens: a dof::LensRequest (dof/lens_resolution.h). Unset values come from the scene's
+    // LensHint, then the defaults documented in docs/dof/lens.md.
     std::optional<float> aperture_radius;   // E, world units
     std::optional<float> fstop;             // with focal_length_mm: E = f / (2 N)
     std::optional<float> focal_length_mm;   // also sets yfov from the sensor height

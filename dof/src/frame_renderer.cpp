@@ -143,6 +143,16 @@ raster::Result<const raster::Frame*> FrameRenderer::pinhole(const raster::Scene&
     return &pinhole_;
 }
 
+raster::Result<ResolvedLens> FrameRenderer::resolveLens(const LensRequest& request,
+                                                        const raster::Scene& scene,
+                                                        const raster::View& view,
+                                                        const raster::RenderOptions& options,
+                                                        raster::FrameStats* stats) {
+    return dof::resolveLens(request, scene, view, [&](const raster::View& v) {
+        return pinhole(scene, v, options, stats);
+    });
+}
+
 const raster::Frame* FrameRenderer::lastPinhole(const raster::Scene& scene,
                                                 const raster::View& view,
                                                 const raster::RenderOptions& options) const {

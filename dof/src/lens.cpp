@@ -23,7 +23,8 @@ float cocRadiusPx(const ThinLens& lens, float depth) {
 }
 
 glm::vec2 lensRayImageOffset(float coc_radius_px, glm::vec2 v) {
-    // Camera y is up, pixel rows grow downwards: only x changes sign (DESIGN.md, "The lens").
+    // Camera y is up, pixel rows grow downwards: only x changes sign (docs/dof/lens.md, "Lens
+    // samples and the sign convention").
     return {-coc_radius_px * v.x, coc_radius_px * v.y};
 }
 
@@ -48,10 +49,10 @@ std::string text(float v) {
 
 Status validate(const ThinLens& lens, const raster::View& view) {
     if (!std::isfinite(lens.aperture_radius) || lens.aperture_radius < 0.0f)
-        return Status::error("--aperture-radius must be a finite number >= 0 (world units), got " +
+        return Status::error("aperture_radius must be a finite number >= 0 (world units), got " +
                              text(lens.aperture_radius));
     if (!std::isfinite(lens.focus_distance) || lens.focus_distance <= 0.0f)
-        return Status::error("--focus-distance must be a finite number > 0 (world units), got " +
+        return Status::error("focus_distance must be a finite number > 0 (world units), got " +
                              text(lens.focus_distance));
     if (view.zfar > 0.0f && lens.focus_distance > view.zfar)
         return Status::error("focus distance " + text(lens.focus_distance) +
@@ -65,13 +66,13 @@ Status validate(const ThinLens& lens, const raster::View& view) {
 raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const raster::View& view,
                                            uint32_t x, uint32_t y) {
     if (x >= pinhole.width || y >= pinhole.height)
-        return Status::error("--focus-pixel " + std::to_string(x) + "," + std::to_string(y) +
+        return Status::error("focus_pixel " + std::to_string(x) + "," + std::to_string(y) +
                              " lies outside the " + std::to_string(pinhole.width) + "x" +
                              std::to_string(pinhole.height) + " image");
     const float stored = pinhole.depth.load(y * pinhole.width + x);
     const float d = raster::distanceFromDepth(view, stored);
     if (!(stored < raster::kFarDepth) || !std::isfinite(d) || d <= 0.0f)
-        return Status::error("--focus-pixel " + std::to_string(x) + "," + std::to_string(y) +
+        return Status::error("focus_pixel " + std::to_string(x) + "," + std::to_string(y) +
                              " shows only background; there is no depth to focus on");
     return d;
 }

@@ -13,6 +13,7 @@
 #include <dof/accum.h>
 #include <dof/gather.h>
 #include <dof/lens.h>
+#include <dof/lens_resolution.h>
 #include <dof/lens_samples.h>
 #include <dof/multilayer.h>
 #include <dof/multiview.h>
@@ -119,10 +120,12 @@ public:
     FrameRenderer& operator=(const FrameRenderer&) = delete;
 
     // Renders one frame of `scene` through `view` and `lens` with `method` into `image`, and,
-    // when `report` is given, fills it. Fails with a Status naming the problem on a null image, a
-    // stride below the row size, an invalid view, lens or settings, a missing sample set or a
-    // failed render (memory budget, textures); the image may then be partly written. Not
-    // reentrant: one call at a time per object (the work itself runs on the pool).
+    // when `report` is given, fills it. The lens owns the focus distance: the view's copy does not
+    // change the image (resolveLens returns a view whose copy agrees). Fails with a Status naming
+    // the problem on a null image, a stride below the row size, an invalid view, lens or settings,
+    // a missing sample set or a failed render (memory budget, textures); the image may then be
+    // partly written. Not reentrant: one call at a time per object (the work itself runs on the
+    // pool).
     [[nodiscard]] raster::Status render(const raster::Scene& scene, const raster::View& view,
                                         const ThinLens& lens, const raster::RenderOptions& options,
                                         const MethodSettings& method, const FrameImage& image,
@@ -137,6 +140,13 @@ public:
                                                                const raster::View& view,
                                                                const raster::RenderOptions& options,
                                                                raster::FrameStats* stats = nullptr);
+
+    // The lens of a frame (lens_resolution.h), focused with this object's pinhole frame: a focus
+    // pixel or autofocus renders it with pinhole() (its counts in `stats`), and the next render()
+    // through the returned view reuses it.
+    [[nodiscard]] raster::Result<ResolvedLens>
+    resolveLens(const LensRequest& request, const raster::Scene& scene, const raster::View& view,
+                const raster::RenderOptions& options, raster::FrameStats* stats = nullptr);
 
     // The last pinhole frame rendered (by pinhole() or a method), when it was rendered for this
     // scene, view and options and the caller has not changed the scene since; else null.

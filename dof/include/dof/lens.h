@@ -1,7 +1,7 @@
-// The thin lens: the one camera-lens model every DOF method in focal shares (DESIGN.md, "The
-// lens"). Consumes a raster::View (for f_px and the clip planes) plus aperture radius and focus
-// distance; produces the signed circle of confusion and the lens-ray image offset. Plain values,
-// no memory owned.
+// The thin lens: the one camera-lens model every DOF method in focal shares (docs/dof/lens.md).
+// Consumes a raster::View (for f_px and the clip planes) plus aperture radius and focus distance;
+// produces the signed circle of confusion and the lens-ray image offset. Plain values, no memory
+// owned.
 //
 // Units and signs
 //   E     aperture (lens) radius, world units, >= 0 (0 = pinhole).
@@ -34,6 +34,8 @@
 
 namespace dof {
 
+// The lens owns the focus distance: a raster::View's focus_distance is only a copy, which the
+// lens-moved views of accum (accum.h, lensView) take from here. lens_resolution.h chooses it.
 struct ThinLens {
     float aperture_radius = 0.0f; // E, world units
     float focus_distance = 1.0f;  // d_f, world units along the view axis
@@ -57,12 +59,12 @@ float apertureRadiusFromFStop(float focal_length_mm, float fstop);
 float yfovFromFocalLength(float focal_length_mm, float sensor_height_mm);
 
 // Rejects NaN/inf, E < 0, d_f <= 0, d_f beyond a finite far plane, f_px <= 0. Messages name the
-// command-line options (--aperture-radius, --focus-distance).
+// fields (aperture_radius, focus_distance); a command line maps them to its options.
 raster::Status validate(const ThinLens& lens, const raster::View& view);
 
 // The focus distance seen at pixel (x, y) of a pinhole frame rendered through `view`: the depth
 // buffer's distance along the view axis. Fails outside the image or where the pixel shows only
-// background (nothing to focus on).
+// background (nothing to focus on); the messages call the pixel focus_pixel.
 raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const raster::View& view,
                                            uint32_t x, uint32_t y);
 

@@ -334,7 +334,7 @@ TEST(Gather, RejectsBadInputWithTheOptionName) {
     raster::Result<dof::GatherStats> bad_lens =
         dof::gather(imageOf(f), dof::makeThinLens(view, -1.0f, kFocus), view, {}, out);
     ASSERT_FALSE(bad_lens.ok());
-    EXPECT_NE(bad_lens.status().message().find("--aperture-radius"), std::string::npos);
+    EXPECT_NE(bad_lens.status().message().find("aperture_radius"), std::string::npos);
 
     f.depth.float32[5 * 32 + 7] = 1.5f;
     f.depth.float32[9 * 32 + 1] = NAN;

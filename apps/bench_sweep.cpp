@@ -1,0 +1,62 @@
+#include "apps/bench_sweep.h"
+
+namespace focal {
+
+// accum's N doubles from 4 to 256 so that every equal-error target between the cheapest and the
+// best accum is bracketed by two neighbouring settings (apps/equal_error.h); the other methods
+// cover their useful range. The studies keep the settings they had before the sweeps grew:
+// accum N = 16 (quick: 8) for both; the others' first for scaling, last for temporal.
+std::vector<Setting> settingsFor(const std::string& method, bool quick) {
+    if (method == "pinhole")
+        return {{"default", {}}};
+    if (method == "accum") {
+        const std::vector<int> ns =
+            quick ? std::vector<int>{4, 8, 16, 32} : std::vector<int>{4, 8, 16, 32, 64, 128, 256};
+        const int study = quick ? 8 : 16;
+        std::vector<Setting> out;
+        for (int n : ns)
+            out.push_back({"N=" + std::to_string(n),
+                           {"--samples", std::to_string(n)},
+                           n == study,
+                           n == study});
+        return out;
+    }
+    if (method == "gather") {
+        auto g = [](const char* r) {
+            return Setting{std::string("R=") + r, {"--gather-max-radius", r}};
+        };
+        if (quick)
+            return {g("16")};
+        return {g("8"), g("16"), g("32")};
+    }
+    if (method == "multiview") {
+        auto m = [](const char* spacing, const char* samples) {
+            return Setting{std::string("spacing=") + spacing + ",N=" + samples,
+                           {"--layers", "0", "--layer-spacing", spacing, "--samples", samples}};
+        };
+        if (quick)
+            return {m("4", "16")};
+        Setting first = m("4", "16");
+        first.scaling = true;
+        return {m("4", "8"), first, m("2", "32"), m("1", "64")};
+    }
+    if (method == "multilayer") {
+        auto m = [](const char* n) {
+            return Setting{std::string("frags=") + n, {"--fragments-per-pixel", n}};
+        };
+        if (quick)
+            return {m("4")};
+        return {m("2"), m("4"), m("8")};
+    }
+    return {{"default", {}}};
+}
+
+Setting studySetting(const std::string& method, bool quick, bool Setting::*flag) {
+    const std::vector<Setting> all = settingsFor(method, quick);
+    for (const Setting& s : all)
+        if (s.*flag)
+            return s;
+    return flag == &Setting::scaling ? all.front() : all.back();
+}
+
+} // namespace focal
