@@ -200,8 +200,8 @@ raster::Status writeDebugPictures(const std::string& prefix, const raster::View&
             for (uint32_t x = 0; x < tw; ++x) {
                 const float d = nb.at(k, x * scale, y * scale);
                 levels.set(o.x + x, o.y + y,
-                           d <= 1.0f ? grey(raster::distanceFromDepth(view, d))
-                                     : glm::vec3(0.25f, 0.02f, 0.02f));
+                           d <= raster::kFarDepth ? grey(raster::distanceFromDepth(view, d))
+                                                  : glm::vec3(0.25f, 0.02f, 0.02f));
             }
     }
     if (raster::Status st = levels.write(prefix + "_nbuffer.png"); !st.ok())
