@@ -24,8 +24,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void runTasks(raster::TaskPool* pool, uint32_t count,
-              const std::function<void(uint32_t, uint32_t)>& fn) {
+void runTasks(raster::TaskPool* pool, uint32_t count, raster::TaskFn fn) {
     if (pool)
         pool->parallelFor(count, fn);
     else

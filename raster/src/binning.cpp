@@ -88,8 +88,8 @@ void binChunks(TaskPool& pool, const GeometryState& geometry, const TileGrid& gr
         for (uint32_t t = 0; t < grid.count(); ++t)
             out.offsets[t + 1] += out.offsets[t];
         out.items.resize(out.offsets[grid.count()]);
-        std::vector<uint32_t> cursor(out.offsets.begin(), out.offsets.end() - 1);
-        visit([&](uint32_t tile, uint32_t ti) { out.items[cursor[tile]++] = ti; });
+        out.cursor.assign(out.offsets.begin(), out.offsets.end() - 1);
+        visit([&](uint32_t tile, uint32_t ti) { out.items[out.cursor[tile]++] = ti; });
     });
 }
 

@@ -23,6 +23,7 @@ TileGrid makeTileGrid(uint32_t width, uint32_t height, uint32_t tile_size);
 struct ChunkBins {
     std::vector<uint32_t> offsets; // tile t owns items[offsets[t], offsets[t+1])
     std::vector<uint32_t> items;   // indices into the chunk's SetupTri array
+    std::vector<uint32_t> cursor;  // scratch of the fill pass, kept to reuse its memory
 };
 
 // Edge function E(p) = a*px + b*py + c of the edge from vertex i to vertex j, in 24.8 fixed

@@ -23,8 +23,9 @@ LightKernel selectLightKernel(bool simd) {
     return useAvx2(simd) ? lightKernelAvx2() : &lightKernelScalar;
 }
 
-std::vector<PreparedLight> prepareLights(const Scene& scene, glm::vec3 default_direction) {
-    std::vector<PreparedLight> out;
+void prepareLights(const Scene& scene, glm::vec3 default_direction,
+                   std::vector<PreparedLight>& out) {
+    out.clear();
     auto set3 = [](float* dst, glm::vec3 v) { dst[0] = v.x, dst[1] = v.y, dst[2] = v.z; };
     if (scene.lights.empty()) {
         // A directional light whose irradiance makes a facing surface show its albedo.
@@ -32,7 +33,7 @@ std::vector<PreparedLight> prepareLights(const Scene& scene, glm::vec3 default_d
         set3(p.radiance, glm::vec3(3.14159265358979f));
         set3(p.direction, glm::normalize(default_direction));
         out.push_back(p);
-        return out;
+        return;
     }
     for (const Light& light : scene.lights) {
         PreparedLight p;
@@ -48,7 +49,6 @@ std::vector<PreparedLight> prepareLights(const Scene& scene, glm::vec3 default_d
         }
         out.push_back(p);
     }
-    return out;
 }
 
 } // namespace raster

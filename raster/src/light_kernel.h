@@ -31,7 +31,8 @@ struct PreparedLight {
 
 // The scene's lights, or one default directional light of intensity pi travelling along
 // `default_direction` when it has none.
-std::vector<PreparedLight> prepareLights(const Scene& scene, glm::vec3 default_direction);
+void prepareLights(const Scene& scene, glm::vec3 default_direction,
+                   std::vector<PreparedLight>& out);
 
 // Surface material constants shared by the lanes (one material per triangle).
 struct LightMaterial {

@@ -126,7 +126,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.filter = options.texture_filter;
     st.ctx.kernel = selectQuadKernel(options.simd);
     st.ctx.blend_last = hasBlendMaterial(scene);
-    st.lights = prepareLights(scene, defaultLightDirection(view));
+    prepareLights(scene, defaultLightDirection(view), st.lights);
     st.ctx.shade.lights = st.lights.data();
     st.ctx.shade.light_count = uint32_t(st.lights.size());
     st.ctx.shade.light_kernel = selectLightKernel(options.simd);
@@ -205,7 +205,8 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
     if (Status s = validate(view); !s.ok())
         return s;
     if (Status s = checkMemory(
-            options.memory_budget, "a " + sizeText(view) + " frame (colour and depth)",
+            options.memory_budget,
+            [&] { return "a " + sizeText(view) + " frame (colour and depth)"; },
             frameBytes(view.width, view.height, options.depth_format, hasBlendMaterial(scene)));
         !s.ok())
         return s;
@@ -253,11 +254,14 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     if (Status s = validate(view); !s.ok())
         return s;
     const uint32_t layer_count = uint32_t(desc.bounds.size() - 1);
-    if (Status s = checkMemory(options.memory_budget,
-                               "a " + sizeText(view) + " layered target with " +
-                                   std::to_string(layer_count) + " layers",
-                               layeredTargetBytes(view.width, view.height, layer_count, desc,
-                                                  hasBlendMaterial(scene)));
+    if (Status s = checkMemory(
+            options.memory_budget,
+            [&] {
+                return "a " + sizeText(view) + " layered target with " +
+                       std::to_string(layer_count) + " layers";
+            },
+            layeredTargetBytes(view.width, view.height, layer_count, desc,
+                               hasBlendMaterial(scene)));
         !s.ok())
         return s;
     if (Status s = prepare(scene, view, options, stats); !s.ok())
@@ -342,9 +346,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     if (Status s = validate(view); !s.ok())
         return s;
     // Heads, offsets and list lengths per pixel, before any fragment is collected.
-    if (Status s = checkMemory(options.memory_budget,
-                               "the per-pixel list heads of a " + sizeText(view) + " image",
-                               mulBytes(uint64_t(view.width) * view.height, 12));
+    if (Status s = checkMemory(
+            options.memory_budget,
+            [&] { return "the per-pixel list heads of a " + sizeText(view) + " image"; },
+            mulBytes(uint64_t(view.width) * view.height, 12));
         !s.ok())
         return s;
     if (Status s = prepare(scene, view, options, stats); !s.ok())
@@ -401,9 +406,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     // The collected nodes, plus what the resolve stores per kept fragment (at most all of them).
     const uint64_t per_fragment = sizeof(FragmentNode) + bytesPerColor(desc.color_format) +
                                   bytesPerDepth(desc.depth_format) + sizeof(uint32_t);
-    if (Status s = checkMemory(options.memory_budget,
-                               std::to_string(collected) + " fragments in per-pixel lists",
-                               mulBytes(collected, per_fragment));
+    if (Status s = checkMemory(
+            options.memory_budget,
+            [&] { return std::to_string(collected) + " fragments in per-pixel lists"; },
+            mulBytes(collected, per_fragment));
         !s.ok())
         return s;
     if (collected > desc.node_capacity) {

@@ -20,7 +20,7 @@ struct SurfaceShader::Impl {
 
 SurfaceShader::SurfaceShader(const Scene& scene, const View& view, bool simd)
     : impl_(std::make_unique<Impl>()) {
-    impl_->lights = prepareLights(scene, defaultLightDirection(view));
+    prepareLights(scene, defaultLightDirection(view), impl_->lights);
     impl_->ctx.scene = &scene;
     impl_->ctx.lights = impl_->lights.data();
     impl_->ctx.light_count = uint32_t(impl_->lights.size());

@@ -58,7 +58,7 @@ void TaskPool::workerLoop(uint32_t worker) {
     }
 }
 
-void TaskPool::parallelFor(uint32_t count, const std::function<void(uint32_t, uint32_t)>& fn) {
+void TaskPool::parallelFor(uint32_t count, TaskFn fn) {
     if (count == 0)
         return;
     if (threads_.empty() || count == 1) {

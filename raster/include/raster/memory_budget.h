@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <type_traits>
 
 namespace raster {
 
@@ -32,6 +33,15 @@ std::string formatBytes(uint64_t bytes);
 // "multiview scratch needs 12.3 GiB, more than the memory budget of 8 GiB (--memory-budget)".
 // `what` names the buffer(s) in words the user knows.
 Status checkMemory(const MemoryBudget& budget, std::string_view what, uint64_t needed);
+// The same with `what()` building the words only when the check fails, so a request that fits
+// allocates nothing for its message (a frame rendered again allocates nothing at all).
+template <class Describe>
+requires std::is_invocable_r_v<std::string, Describe&>
+    Status checkMemory(const MemoryBudget& budget, Describe&& what, uint64_t needed) {
+    if (!budget.limited() || needed <= budget.bytes)
+        return {};
+    return checkMemory(budget, std::string_view(what()), needed);
+}
 
 // Saturating arithmetic for byte estimates: a product or sum that would overflow is
 // UINT64_MAX, which no budget admits.

@@ -8,12 +8,34 @@
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
-#include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace raster {
+
+// A non-owning reference to a callable `void(uint32_t index, uint32_t worker)`: what
+// parallelFor runs. Unlike std::function it never allocates (a lambda capturing more than two
+// pointers would, on every call), so a frame's many parallelFor calls allocate nothing. The
+// callable must outlive the call it is passed to, as a temporary lambda argument does.
+class TaskFn {
+public:
+    template <class Fn>
+    requires(!std::is_same_v<std::remove_cvref_t<Fn>, TaskFn> &&
+             std::is_invocable_v<Fn&, uint32_t, uint32_t>)
+        TaskFn(Fn&& fn) // NOLINT(google-explicit-constructor): lambdas convert implicitly
+        : object_(const_cast<void*>(static_cast<const void*>(std::addressof(fn)))),
+          call_([](void* object, uint32_t index, uint32_t worker) {
+              (*static_cast<std::remove_reference_t<Fn>*>(object))(index, worker);
+          }) {}
+    void operator()(uint32_t index, uint32_t worker) const { call_(object_, index, worker); }
+
+private:
+    void* object_;
+    void (*call_)(void*, uint32_t, uint32_t);
+};
 
 class TaskPool {
 public:
@@ -30,7 +52,7 @@ public:
     // The calling thread takes part as worker 0. Not reentrant. If fn throws (std::bad_alloc
     // in practice), the remaining indices are skipped and the first exception is rethrown here
     // on the calling thread, instead of ending the process in std::terminate on a worker.
-    void parallelFor(uint32_t count, const std::function<void(uint32_t, uint32_t)>& fn);
+    void parallelFor(uint32_t count, TaskFn fn);
 
 private:
     void workerLoop(uint32_t worker);
@@ -42,7 +64,7 @@ private:
     std::mutex mutex_;
     std::condition_variable wake_;
     std::condition_variable done_;
-    const std::function<void(uint32_t, uint32_t)>* job_ = nullptr;
+    const TaskFn* job_ = nullptr;
     uint32_t job_count_ = 0;
     uint64_t generation_ = 0;
     uint32_t busy_ = 0;

@@ -44,7 +44,8 @@ TEST(Lighting, KernelMatchesTheModel) {
     b.direction = {-0.7f, -0.2f, -0.6f};
     b.intensity = 0.8f;
     scene.lights = {a, b};
-    const auto lights = raster::prepareLights(scene, glm::vec3(0, -1, 0));
+    std::vector<raster::PreparedLight> lights;
+    raster::prepareLights(scene, glm::vec3(0, -1, 0), lights);
     uint32_t state = 7u;
     auto unit = [&state] {
         state = state * 1664525u + 1013904223u;

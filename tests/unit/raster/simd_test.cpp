@@ -79,8 +79,8 @@ TEST(Simd, LightKernelMatchesScalarBitForBit) {
     spot.inner_cone_angle = 0.2f;
     spot.outer_cone_angle = 0.6f;
     scene.lights = {sun, bulb, spot};
-    const std::vector<raster::PreparedLight> lights =
-        raster::prepareLights(scene, glm::vec3(0.0f, -1.0f, 0.0f));
+    std::vector<raster::PreparedLight> lights;
+    raster::prepareLights(scene, glm::vec3(0.0f, -1.0f, 0.0f), lights);
     const float eye[3] = {0.0f, 1.0f, 5.0f};
     for (int i = 0; i < 5000; ++i) {
         raster::LightLanes a;
