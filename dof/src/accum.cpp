@@ -38,7 +38,8 @@ glm::vec2 pixelJitter(uint32_t index) {
 raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens& lens,
                                        const LensSampleSet& samples, const AccumSettings& settings,
                                        const RenderFn& render, raster::Frame& out,
-                                       raster::TaskPool* pool, const ProgressFn& progress) {
+                                       raster::TaskPool* pool, const ProgressFn& progress,
+                                       AccumScratch* kept) {
     if (Status s = validate(lens, view); !s.ok())
         return s;
     if (samples.size() == 0)
@@ -76,8 +77,11 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
     // One view per lens sample, added in sample order (the determinism contract).
     const uint32_t width = out.width, height = out.height;
     const size_t floats = size_t(width) * height * 4;
-    std::vector<double> acc(floats, 0.0);
-    raster::Frame scratch;
+    AccumScratch local;
+    AccumScratch& buffers = kept ? *kept : local;
+    buffers.sums.assign(floats, 0.0);
+    double* acc = buffers.sums.data();
+    raster::Frame& scratch = buffers.view;
     double weight_sum = 0.0;
     const uint32_t n = samples.size();
     for (uint32_t i = 0; i < n; ++i) {

@@ -222,9 +222,17 @@ raster::Status FrameRenderer::render(const raster::Scene& scene, const raster::V
             return Status::error("accum: needs lens samples (AccumMethod::samples is null)");
         // The first render is the pinhole (lens centre) into the output frame: the kept one is
         // copied there instead.
-        const RenderFn render_view = [&](const raster::View& v, raster::Frame& f) -> Status {
-            if (&f == &accum_ && kept && pinholeMatches(scene, v, options)) {
-                report.pinhole_reused = true;
+        // The callback captures two pointers, which std::function stores without allocating.
+        const struct {
+            const raster::Scene& scene;
+            const raster::RenderOptions& options;
+            FrameReport& report;
+            bool kept;
+        } call{scene, options, report, kept};
+        const RenderFn render_view = [this, &call](const raster::View& v,
+                                                   raster::Frame& f) -> Status {
+            if (&f == &accum_ && call.kept && pinholeMatches(call.scene, v, call.options)) {
+                call.report.pinhole_reused = true;
                 accum_.width = pinhole_.width;
                 accum_.height = pinhole_.height;
                 accum_.color = pinhole_.color;
@@ -232,10 +240,11 @@ raster::Status FrameRenderer::render(const raster::Scene& scene, const raster::V
                 accum_.transparent_depth = pinhole_.transparent_depth;
                 return {};
             }
-            return renderPinhole(scene, v, options, f, report);
+            return renderPinhole(call.scene, v, call.options, f, call.report);
         };
-        raster::Result<AccumStats> r = renderAccum(view, lens, *m->samples, m->settings,
-                                                   render_view, accum_, &pool_, m->progress);
+        raster::Result<AccumStats> r =
+            renderAccum(view, lens, *m->samples, m->settings, render_view, accum_, &pool_,
+                        m->progress, &accum_scratch_);
         if (!r.ok())
             return r.status();
         copyRows(accum_.color.data(), view.width, view.height, image);

@@ -45,13 +45,7 @@ uint32_t reachOf(float max_r) {
 }
 
 // What the coc stage found in one tile; combined in tile order.
-struct TileCoc {
-    size_t first_bad = SIZE_MAX; // first pixel (row-major index) with bad input
-    bool bad_depth = false;      // else: bad colour
-    float min_c = INFINITY;
-    float max_c = -INFINITY;
-    uint64_t clamped = 0;
-};
+using TileCoc = GatherScratch::TileCoc;
 
 struct Plan {
     uint32_t width = 0, height = 0, tile = 0, tiles_x = 0, tiles_y = 0;
@@ -313,13 +307,20 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
         out_coc->resize(pixels);
     // Reach blocks: vertical pass, max radius per (tile column, 8-row block); horizontal pass,
     // per (row, 8-column block). Each block lies inside one tile, so its tile's task writes it.
-    std::vector<float> vblock(size_t(p.tiles_x) * p.row_blocks);
-    std::vector<float> hblock(size_t(p.height) * p.col_blocks);
+    std::vector<float>& vblock = ws.vblock;
+    std::vector<float>& hblock = ws.hblock;
+    vblock.assign(size_t(p.tiles_x) * p.row_blocks, 0.0f);
+    hblock.assign(size_t(p.height) * p.col_blocks, 0.0f);
     const size_t worker_floats = size_t(p.tile) * 7 + size_t(p.tile + 2 * p.reach) * 7;
     ws.worker.resize(worker_floats * workers);
-    std::vector<TileCoc> tile_coc(tiles);
-    std::vector<uint64_t> tile_samples(tiles, 0);
-    std::vector<uint8_t> copied_v(tiles, 0), copied_h(tiles, 0);
+    std::vector<TileCoc>& tile_coc = ws.tile_coc;
+    std::vector<uint64_t>& tile_samples = ws.tile_samples;
+    std::vector<uint8_t>& copied_v = ws.copied_v;
+    std::vector<uint8_t>& copied_h = ws.copied_h;
+    tile_coc.assign(tiles, TileCoc{});
+    tile_samples.assign(tiles, 0);
+    copied_v.assign(tiles, 0);
+    copied_h.assign(tiles, 0);
 
     // --- coc: C = a D + b and the per-pixel weight terms (§4.1, §4.2) ---
     auto t0 = std::chrono::steady_clock::now();

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace dof {
 
@@ -44,6 +45,13 @@ struct AccumStats {
     double ms_accumulate = 0.0; // adding them up and normalising
 };
 
+// Buffers kept from frame to frame by a caller that renders again (dof::FrameRenderer keeps
+// one): the running sums and the frame each lens view renders into. Sized by renderAccum.
+struct AccumScratch {
+    std::vector<double> sums; // RGBA per pixel
+    raster::Frame view;
+};
+
 // The sheared view for lens sample `sample` (lens units) and sub-pixel shift `pixel_shift`.
 raster::View lensView(const raster::View& view, const ThinLens& lens, glm::vec2 sample,
                       glm::vec2 pixel_shift);
@@ -55,11 +63,13 @@ glm::vec2 pixelJitter(uint32_t index);
 // when E = 0 or every visible depth has |C(d)| < 0.5 px and pixel jitter is off, that is the
 // result (stats.skipped). Otherwise renders one view per sample and averages them with the
 // samples' weights in linear light. `pool` (may be null) parallelises the accumulation over
-// rows. Fails if the lens is invalid or a render fails.
+// rows. `scratch` (may be null: local buffers) keeps the buffers for the next call. Fails if
+// the lens is invalid or a render fails.
 raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens& lens,
                                        const LensSampleSet& samples, const AccumSettings& settings,
                                        const RenderFn& render, raster::Frame& out,
                                        raster::TaskPool* pool = nullptr,
-                                       const ProgressFn& progress = {});
+                                       const ProgressFn& progress = {},
+                                       AccumScratch* scratch = nullptr);
 
 } // namespace dof

@@ -179,6 +179,7 @@ private:
     std::optional<PinholeKey> pinhole_key_; // what pinhole_ holds, when it holds a pinhole
     bool pinhole_kept_ = false;             // made by pinhole() for the next render()
     raster::Frame accum_;                   // accum's output (colour average, pinhole depth)
+    AccumScratch accum_scratch_;            // accum's sums and view frame
     std::vector<float> rgba_;               // gather's and multiview's output
     GatherScratch gather_scratch_;
     raster::LayeredTarget layers_; // multiview's layered target (§4.2)

@@ -22,6 +22,8 @@
 #include <raster/storage.h>
 #include <raster/task_pool.h>
 
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -110,6 +112,19 @@ struct GatherScratch {
     std::vector<float> vertical;  // RGBA output of the vertical pass
     std::vector<float> worker;    // per-worker accumulators and padded rows
     std::vector<uint16_t> reach;  // per tile/row-block loop bounds
+    std::vector<float> vblock;    // max radius per (tile column, 8-row block): vertical pass
+    std::vector<float> hblock;    // max radius per (row, 8-column block): horizontal pass
+    // The coc stage's per-tile reduction, combined in tile order afterwards.
+    struct TileCoc {
+        size_t first_bad = SIZE_MAX; // first pixel (row-major index) with bad input
+        bool bad_depth = false;      // else: bad colour
+        float min_c = INFINITY;
+        float max_c = -INFINITY;
+        uint64_t clamped = 0;
+    };
+    std::vector<TileCoc> tile_coc;
+    std::vector<uint64_t> tile_samples;      // samples added per tile
+    std::vector<uint8_t> copied_v, copied_h; // per tile: the pass copied instead of filtering
 };
 
 // Runs the filter. `out_rgba` is resized to width*height*4; `out_coc`, when given, receives the
