@@ -1,0 +1,468 @@
+// Multiview's tile tracer (§4.3-§4.5): per pixel, its lens rays (jittered, §4.5) traced layer
+// by layer through the height fields, coned and shaded, and their weighted mean. Consumes the
+// Tracer built by multiview.cpp and multiview_setup.cpp; produces the tile's RGBA pixels and its
+// TileCounters; ray and pixel states live in the caller's per-worker buffers. Everything a ray
+// calls is in the .inl files included here, so each traceTile copy inlines all of it.
+#include "multiview_tracer.h"
+
+#include "multiview_cones.inl"
+#include "multiview_shading.inl"
+#include "multiview_traversal.inl"
+
+#include <raster/simd.h>
+
+#include <bit>
+
+namespace dof::multiview_detail {
+namespace {
+
+// Cone coverage at or above this ends the traversal (the cone is fully blocked, §4.4).
+constexpr float kFullCoverage = 0.999f;
+// A path walked in advance is culled per ray only when longer than this: an N-buffer query
+// costs about as much as scanning that many cells (tracing time on demo, dense and foliage at
+// N = 64 with thresholds 0, 4, 8 and never: 8 and never were fastest, 0 slowest by 10-20 %).
+constexpr uint32_t kRayCullMinCells = 8;
+
+// The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
+LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
+                          const std::array<float, 4>& noise, uint32_t halton_offset) {
+    const MultiviewSettings& s = *tr.settings;
+    switch (s.jitter) {
+    case JitterMode::None:
+        return tr.samples->sample(k);
+    case JitterMode::Rotate:
+        return tr.samples->sample(x, y, k);
+    case JitterMode::Halton: {
+        const LensSampleSet& seq = *s.sequence_2n;
+        return seq.sample((halton_offset + k) % seq.size());
+    }
+    case JitterMode::Noise: {
+        // 16 pairwise combinations (n_i, n_j) of the texel's four components, each applied to
+        // 1/16th of the samples, scaled to half the mean sample spacing (§4.5).
+        LensSample ls = tr.samples->sample(k);
+        const uint32_t combo = k % 16;
+        const glm::vec2 off(noise[combo / 4], noise[combo % 4]);
+        glm::vec2 p = ls.position + tr.lambda * off;
+        const float len = glm::length(p);
+        if (len > tr.r_max)
+            p *= tr.r_max / len; // stay within the aperture's radius
+        ls.position = p;
+        return ls;
+    }
+    }
+    return tr.samples->sample(k);
+}
+
+// The records of pixel (x, y)'s rays in sample order when it is the debug pixel, else null.
+// beginRays sizes them (`size` rays) before anything is recorded; the others pass 0.
+MultiviewRayRecord* debugRecords(const Tracer& tr, uint32_t x, uint32_t y, uint32_t size = 0) {
+    const MultiviewSettings& s = *tr.settings;
+    if (!s.debug_rays || x != s.debug_x || y != s.debug_y)
+        return nullptr;
+    if (size > 0)
+        s.debug_rays->assign(size, MultiviewRayRecord{});
+    return s.debug_rays->data();
+}
+
+// Whether pixel (x, y)'s ray with offset w lies in the image at stored depth t.
+bool rayInside(const Tracer& tr, uint32_t x, uint32_t y, glm::vec2 w, float t) {
+    const glm::vec2 o = tr.offsetOf(w, t);
+    return o.x >= -float(x) && o.y >= -float(y) && o.x < float(tr.width - x) &&
+           o.y < float(tr.height - y);
+}
+
+// A pixel in focus, resolved without tracing. Let l be its nearest active layer (nothing nearer
+// can be hit or seen by a cone: per-pixel culling with the cone margin) and h the depth of its
+// own texel there. When h lies where every ray crosses the own texel's column (LayerSeg::
+// focus_t0/t1), and no texel the rays cross before it can stop them (each such cell is left
+// at D <= focus_t0, so a texel deeper than focus_t0, or nearer than the segment, is no hit for
+// cellHit), the scan (scanPath) hits the own texel at h with every ray. There is no cone (lambda
+// |C(h)| <= 1), so each ray's colour is the texel's, and the mean is summed as endPixel sums
+// it: the same bits as tracing the rays. Writes the pixel and returns true, or returns false
+// when the rays have to be traced.
+bool inFocusPixel(const Tracer& tr, uint32_t x, uint32_t y, const PixelLayers& pl, float* out,
+                  TileCounters& cnt) {
+    if (pl.active == 0)
+        return false;
+    const uint32_t l = uint32_t(std::countr_zero(pl.active));
+    const LayerSeg& seg = tr.segs[l];
+    const float* depth = tr.scratch->depth[l].data();
+    const uint32_t texel = y * tr.width + x;
+    const float h = depth[texel];
+    if (!((pl.hittable >> l) & 1) || seg.transparent ||
+        !(h >= seg.t0 && h >= seg.focus_t0 && h <= seg.focus_t1) ||
+        (tr.settings->cone && tr.lambda * std::fabs(tr.cocOf(h)) > 1.0f))
+        return false;
+    const auto& box = seg.focus_box;
+    if (box.x0 <= box.x1) {
+        if (int64_t(x) + box.x0 < 0 || int64_t(y) + box.y0 < 0 ||
+            int64_t(x) + box.x1 >= int64_t(tr.width) || int64_t(y) + box.y1 >= int64_t(tr.height))
+            return false; // clamped reads near the border: traced
+        for (int32_t dy = box.y0; dy <= box.y1; ++dy)
+            for (int32_t dx = box.x0; dx <= box.x1; ++dx) {
+                const float hb = depth[int64_t(texel) + int64_t(dy) * tr.width + dx];
+                if ((dx != 0 || dy != 0) && hb >= seg.t0 && hb <= seg.focus_t0)
+                    return false;
+            }
+    }
+    const raster::LayeredTarget& lt = *tr.layers;
+    const glm::vec3 c(lt.color.load(lt.index(l, texel)));
+    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
+    for (uint32_t k = 0; k < tr.samples->size(); ++k) {
+        const double wt = double(tr.samples->sample(k).weight);
+        sum_r += wt * double(c.r);
+        sum_g += wt * double(c.g);
+        sum_b += wt * double(c.b);
+        sum_w += wt;
+    }
+    out[0] = float(sum_r / sum_w);
+    out[1] = float(sum_g / sum_w);
+    out[2] = float(sum_b / sum_w);
+    out[3] = 1.0f;
+    cnt.rays += tr.samples->size();
+    ++cnt.pixels_in_focus;
+    return true;
+}
+
+// The start of each of pixel (x, y)'s rays.
+void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
+    // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
+    std::array<float, 4> noise{};
+    uint32_t halton_offset = 0;
+    if (s.jitter == JitterMode::Noise)
+        for (uint32_t c = 0; c < 4; ++c)
+            noise[c] = hashToUnit(hashWords(x, y, s.seed, 0x6e6f6973u + c)) - 0.5f;
+    if (s.jitter == JitterMode::Halton)
+        halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
+    const uint32_t n = tr.samples->size();
+    const float t_first = tr.segs.front().t0;
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    MultiviewRayRecord* records = debugRecords(tr, x, y, n);
+    for (uint32_t k = 0; k < n; ++k) {
+        ++cnt.rays;
+        RayState& ray = rays[k];
+        ray = RayState{};
+        ray.lens = jitteredSample(tr, x, y, k, noise, halton_offset);
+        ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
+        ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
+        ray.t_end = tr.segs.back().t1;
+        MultiviewRayRecord* rec = records ? records + k : nullptr;
+        if (rec) {
+            rec->lens = ray.lens.position;
+            rec->weight = ray.lens.weight;
+            rec->t_start = t_first;
+            rec->start_px = glm::vec2(cx, cy) + tr.cocOf(t_first) * ray.w;
+        }
+        if (s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_first)) {
+            ++cnt.discarded; // the path starts outside the image
+            ray.discarded = true;
+            ray.transmit = 0.0f;
+            if (rec)
+                rec->discarded = true, rec->t_end = t_first, rec->end_px = rec->start_px;
+        }
+    }
+}
+
+// Ray k of pixel (x, y) through layer l (§4.3-§4.4): its opaque hit or miss, the layer's
+// transparent plane in front of it, and the cone of either.
+void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hittable, uint32_t k,
+                RayState& ray, MultiviewRayRecord* rec, TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
+    const raster::View& view = *tr.view;
+    const raster::LayeredTarget& lt = *tr.layers;
+    const bool shade = s.view_dependent || s.env_map;
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    const glm::vec2 w = ray.w, wc = ray.wc;
+    // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
+    const glm::vec3 shade_from =
+        s.view_dependent ? view.eye + tr.lens->aperture_radius * (ray.lens.position.x * view.right +
+                                                                  ray.lens.position.y * view.up)
+                         : view.eye;
+    // §4.4: a cone of coverage v1 and colour c1 gives v1 c1 + (1 - v1) c2, c2 what the rest
+    // of the ray sees; from kFullCoverage on it blocks the ray (returns true).
+    auto blend = [&](float v1, glm::vec3 c1) {
+        if (v1 >= kFullCoverage) {
+            ray.color += ray.transmit * c1;
+            ray.transmit = 0.0f;
+            return true;
+        }
+        ray.color += ray.transmit * v1 * c1;
+        ray.transmit *= 1.0f - v1;
+        return false;
+    };
+    ++cnt.layer_steps;
+    const LayerSeg& seg = tr.segs[l];
+    const float s0 = std::max(seg.t0, ray.t_resume);
+    if (!(s0 < seg.t1))
+        return;
+    // The whole segment's path walked in advance, unless the ray resumes inside it.
+    const RayPath* path =
+        !tr.paths.empty() && s0 == seg.t0 ? &tr.paths[size_t(k) * tr.segs.size() + l] : nullptr;
+    bool can_hit = hittable;
+    if (can_hit && s.culling && (!path || path->count > kRayCullMinCells)) {
+        // Per-ray culling: the texels this ray's segment can read lie in the box of its end
+        // points; one N-buffer query skips the height-field test when none of them is within
+        // the layer (the same test as §4.3's per-pixel culling, on a smaller window, so it is
+        // just as lossless). Short paths walked in advance are scanned without it.
+        const CellBox box = path ? CellBox{path->box_x0, path->box_x1, path->box_y0, path->box_y1}
+                                 : cellBox(tr.offsetOf(w, s0), tr.offsetOf(w, seg.t1));
+        if (boxCulled(tr, l, int64_t(x) + box.x0, int64_t(x) + box.x1, int64_t(y) + box.y0,
+                      int64_t(y) + box.y1)) {
+            ++cnt.culled_ray;
+            can_hit = false;
+        }
+    }
+    auto trace = [&](const std::vector<float>& depth, float near, float t_a, float t_b) {
+        return s.traversal == Traversal::Scan
+                   ? scanHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt)
+                   : traceHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt);
+    };
+    Hit h;
+    if (can_hit) {
+        ++cnt.layer_tests;
+        h = path ? scanPath(tr, tr.scratch->depth[l].data(), seg.t0, seg.t1, x, y, *path, cnt)
+                 : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
+    }
+    // A ray that crossed the whole segment without a hit still has a cone (missCone),
+    // composited in depth order with the transparent plane.
+    std::optional<MissCone> miss;
+    if (!h.hit && seg.cone_px > 0.0f && s0 == seg.t0)
+        miss = missCone(tr, l, cx, cy, wc, shade, shade_from, cnt);
+    auto addMiss = [&] {
+        if (blend(miss->v1, miss->c1))
+            ray.t_end = miss->t;
+        if (rec) {
+            rec->layer = int32_t(l);
+            ++rec->missed_cones;
+        }
+        miss.reset();
+    };
+    // The layer's transparent plane in front of its opaque hit. The plane holds only depths of
+    // the layer's own interval (LayerSink routes each BLEND fragment to the one layer owning
+    // its depth), so only that part of the segment is searched. Its premultiplied colour is
+    // added and the rest of the ray is seen through (1 - opacity); with cone tracing both come
+    // from its mipmap (§4.4).
+    const float ta = std::max(s0, seg.own0);
+    const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
+    if (can_hit && seg.transparent && ta < tb) {
+        const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
+        if (ht.hit && miss && miss->t < ht.t)
+            addMiss(); // the missed cone's content lies in front of the pane
+        if (ht.hit && ray.transmit > 0.0f) {
+            ++cnt.transparent_hits;
+            const float ct = tr.cocOf(ht.t);
+            const glm::vec4 m = s.cone && tr.lambda * std::fabs(ct) > 1.0f
+                                    ? sampleCone(tr, tr.transparent_mips[l], cx + ct * wc.x,
+                                                 cy + ct * wc.y, tr.lambda * std::fabs(ct))
+                                    : lt.transparent_color.load(lt.index(l, ht.texel));
+            glm::vec3 rgb(m);
+            const size_t ti = lt.index(l, ht.texel);
+            if (shade && lt.transparent_top_alpha[ti] > 0.0f) {
+                // §5 for the plane: the composite is linear in its top pane's colour, which the
+                // rasterizer shaded from the lens centre; swap in the top pane shaded from this
+                // ray's origin (scaled by the cone's share of the texel's opacity).
+                const raster::GSample& g = lt.transparent_gbuffer[ti];
+                const glm::vec3 world = texelWorld(tr, ht.texel, ht.t);
+                const glm::vec3 centre = tr.shader->shade(g, world, view.eye);
+                const glm::vec3 from_ray = shadeSample(tr, g, world, shade_from);
+                const float texel_a = lt.transparent_color.load(ti).a;
+                const float share = texel_a > 0.0f ? std::min(m.a / texel_a, 1.0f) : 0.0f;
+                rgb += share * lt.transparent_top_alpha[ti] * (from_ray - centre);
+            }
+            ray.color += ray.transmit * rgb;
+            ray.transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
+            ray.t_end = ht.t;
+            if (rec)
+                rec->layer = int32_t(l);
+        }
+    }
+    if (!h.hit) {
+        if (miss)
+            addMiss();
+        return;
+    }
+    const float c_hit = tr.cocOf(h.t);
+    glm::vec3 c1;
+    float v1 = 1.0f;
+    const bool cone_hit = s.cone && tr.lambda * std::fabs(c_hit) > 1.0f;
+    if (cone_hit) {
+        // §4.4: a cone of diameter lambda |C(d_i)| around the ray; the mipmapped alpha is its
+        // coverage v1, the mipmapped RGB / v1 its mean colour c1.
+        const glm::vec4 m = sampleCone(tr, tr.mips[l], cx + c_hit * wc.x, cy + c_hit * wc.y,
+                                       tr.lambda * std::fabs(c_hit));
+        v1 = std::clamp(m.a, 0.0f, 1.0f);
+        c1 = v1 > 0.0f ? glm::vec3(m) / m.a : glm::vec3(0.0f);
+    } else {
+        c1 = glm::vec3(lt.color.load(lt.index(l, h.texel)));
+    }
+    if (shade)
+        c1 = cone_hit ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * wc.x, cy + c_hit * wc.y,
+                                       0.5f * tr.lambda * std::fabs(c_hit), shade_from)
+                      : shadeHit(tr, l, h.texel, h.t, shade_from);
+    if (rec)
+        rec->layer = int32_t(l);
+    ray.t_end = h.t;
+    if (blend(v1, c1))
+        return; // the ray ends here (transmit 0)
+    // Continue along the centre ray for c2.
+    ++cnt.cone_partial;
+    if (rec)
+        ++rec->partial_hits;
+    ray.t_resume = h.t_behind + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
+}
+
+// The end of pixel (x, y)'s rays: the background behind them, the paths that left the image
+// (Discard), and the weighted mean in sample order.
+void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, float* out,
+              TileCounters& cnt) {
+    const MultiviewSettings& s = *tr.settings;
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    const float t_last = tr.segs.back().t1;
+    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
+    MultiviewRayRecord* records = debugRecords(tr, x, y);
+    for (uint32_t k = 0; k < tr.samples->size(); ++k) {
+        const RayState& ray = rays[k];
+        if (ray.discarded)
+            continue;
+        glm::vec3 color = ray.color;
+        float t_end = ray.t_end;
+        MultiviewRayRecord* rec = records ? records + k : nullptr;
+        if (ray.transmit > 0.0f) {
+            ++cnt.background;
+            color += ray.transmit * tr.background;
+            t_end = t_last;
+            if (rec)
+                rec->layer = -1;
+        }
+        if (rec) {
+            rec->t_end = t_end;
+            rec->end_px = glm::vec2(cx, cy) + tr.cocOf(t_end) * ray.w;
+        }
+        if (s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_end)) {
+            ++cnt.discarded; // the path to the hit leaves the image
+            if (rec)
+                rec->discarded = true;
+            continue;
+        }
+        const double wt = double(ray.lens.weight);
+        sum_r += wt * double(color.r);
+        sum_g += wt * double(color.g);
+        sum_b += wt * double(color.b);
+        sum_w += wt;
+    }
+    if (sum_w > 0.0) {
+        out[0] = float(sum_r / sum_w);
+        out[1] = float(sum_g / sum_w);
+        out[2] = float(sum_b / sum_w);
+    } else { // every ray left the image: the pinhole colour
+        const size_t i = (size_t(y) * tr.width + x) * 4;
+        out[0] = tr.pinhole->color[i];
+        out[1] = tr.pinhole->color[i + 1];
+        out[2] = tr.pinhole->color[i + 2];
+    }
+    out[3] = 1.0f;
+}
+
+// The rays of the pixels [x0, x1) x [y0, y1), layer by layer: every ray of the tile meets layer
+// l before any meets layer l + 1, so one layer's texels, mipmaps and N-buffer around the tile
+// stay in the cache while they are read (pixel by pixel, all layers of a tile do not fit in it).
+// Each ray still visits its layers front to back with the same arithmetic, so the bytes are
+// those of tracing each pixel's rays to their ends in turn. `rays` holds (x1-x0)(y1-y0)N states.
+void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+               const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
+               PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
+    const uint32_t n = tr.samples->size();
+    const uint32_t tw = x1 - x0;
+    std::array<LayerCulls, raster::kMaxLayers> culls;
+    if (tr.settings->culling)
+        for (uint32_t i = 0; i < tile_layer_count; ++i)
+            culls[i] = layerCulls(tr, tile_layers[i]);
+    for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+            const size_t p = size_t(y - y0) * tw + (x - x0);
+            PixelLayers& pl = pixel_layers[p];
+            pl = pixelLayers(tr, x, y, tile_layers, tile_layer_count, culls.data(), cnt);
+            if (tr.in_focus && !debugRecords(tr, x, y) &&
+                inFocusPixel(tr, x, y, pl, rgba + (size_t(y) * tr.width + x) * 4, cnt)) {
+                pl.active = 0;
+                pl.resolved = true;
+                continue;
+            }
+            beginRays(tr, x, y, rays + p * n, cnt);
+        }
+    for (uint32_t i = 0; i < tile_layer_count; ++i) {
+        const uint32_t l = tile_layers[i];
+        for (uint32_t y = y0; y < y1; ++y)
+            for (uint32_t x = x0; x < x1; ++x) {
+                const size_t p = size_t(y - y0) * tw + (x - x0);
+                if (!((pixel_layers[p].active >> l) & 1))
+                    continue;
+                const bool hittable = (pixel_layers[p].hittable >> l) & 1;
+                RayState* pr = rays + p * n;
+                MultiviewRayRecord* recs = debugRecords(tr, x, y);
+                uint32_t live = 0;
+                for (uint32_t k = 0; k < n; ++k)
+                    if (pr[k].transmit > 0.0f) {
+                        traceLayer(tr, x, y, l, hittable, k, pr[k], recs ? recs + k : nullptr, cnt);
+                        live += pr[k].transmit > 0.0f ? 1 : 0;
+                    }
+                if (live == 0)
+                    pixel_layers[p].active = 0; // every ray has ended: no layer behind is met
+            }
+    }
+    for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+            const size_t p = size_t(y - y0) * tw + (x - x0);
+            if (!pixel_layers[p].resolved)
+                endPixel(tr, x, y, rays + p * n, rgba + (size_t(y) * tr.width + x) * 4, cnt);
+        }
+}
+
+// traceTile compiled twice, for the baseline x86-64 and for AVX2 (the raster kernels' written-
+// once, compiled-twice form, here by function attributes): `flatten` inlines everything it calls
+// (the tracer's functions and the standard library's inline code) into each copy, so each is
+// compiled whole for its target, and no code built for AVX2 is shared with the baseline copy.
+// Without FMA the AVX2 copy computes the same IEEE operations in the same order (the build
+// forbids contraction and reassociation), so the bytes are the same; what differs is the
+// instructions chosen (a floor is one `vroundss` instead of a dozen SSE2 instructions, selects
+// are blends). The baseline copy is the reference: ShadingInputs::simd = false (`--no-simd`).
+#if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
+#define FOCAL_MULTIVIEW_AVX2 1
+#endif
+
+__attribute__((flatten)) void
+traceTileBaseline(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+                  const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
+                  PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
+    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt);
+}
+
+#ifdef FOCAL_MULTIVIEW_AVX2
+__attribute__((flatten, target("avx2,no-fma"))) void
+traceTileAvx2(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+              const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
+              PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
+    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt);
+}
+#endif
+
+} // namespace
+
+bool culled(const Tracer& tr, uint32_t l, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+            float margin) {
+    const float r = tr.segs[l].reach_px + margin;
+    const int64_t lo = int64_t(std::floor(0.5f - r)), hi = int64_t(std::floor(0.5f + r));
+    return boxCulled(tr, l, int64_t(x0) + lo, int64_t(x1) + hi, int64_t(y0) + lo, int64_t(y1) + hi);
+}
+
+TraceTileFn traceTileFor(bool simd) {
+#ifdef FOCAL_MULTIVIEW_AVX2
+    if (raster::useAvx2(simd))
+        return traceTileAvx2;
+#endif
+    (void)simd;
+    return traceTileBaseline;
+}
+
+} // namespace dof::multiview_detail
