@@ -309,7 +309,10 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
     ++cnt.cone_partial;
     if (rec)
         ++rec->partial_hits;
-    ray.t_resume = h.t_behind + 1e-6f + 1e-3f * (seg.t1 - seg.t0);
+    // Resume a thousandth of the segment behind the slab, and at least one float step: stored
+    // depth D = -n/d has the scale of n/d (camera.h), so an absolute nudge would skip whole
+    // scenes under a tiny near plane.
+    ray.t_resume = std::nextafter(h.t_behind + 1e-3f * (seg.t1 - seg.t0), INFINITY);
 }
 
 // The end of pixel (x, y)'s rays: the background behind them, the paths that left the image

@@ -212,12 +212,12 @@ inline CellBox cellBox(glm::vec2 o0, glm::vec2 o1) {
 // One lens ray between the layers of its pixel (traceTile traces a tile layer by layer, so each
 // ray's state waits here while the other rays of the tile meet the same layer).
 struct RayState {
-    LensSample lens;       // jittered lens position (§4.5) and weight
-    glm::vec2 w{0.0f};     // image offset per unit C (lensRayImageOffset)
-    glm::vec2 wc{0.0f};    // where its cones are centred, per unit C (ConeCentre)
-    glm::vec3 color{0.0f}; // what it has seen so far
-    float transmit = 1.0f; // (1 - v1) products of partially covered cones (§4.4); 0: ended
-    float t_resume = -1.0f;
+    LensSample lens;            // jittered lens position (§4.5) and weight
+    glm::vec2 w{0.0f};          // image offset per unit C (lensRayImageOffset)
+    glm::vec2 wc{0.0f};         // where its cones are centred, per unit C (ConeCentre)
+    glm::vec3 color{0.0f};      // what it has seen so far
+    float transmit = 1.0f;      // (1 - v1) products of partially covered cones (§4.4); 0: ended
+    float t_resume = -INFINITY; // where a continuation behind a partial cone starts (§4.4)
     float t_end = 0.0f;
     bool discarded = false; // its path starts outside the image (OffscreenPolicy::Discard)
 };

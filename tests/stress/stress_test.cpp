@@ -294,7 +294,7 @@ std::vector<StressCase> stressCases() {
                          "base", 0.002, "far plane 1e8"});
         cases.push_back({"far_infinite", m, with(stage(0, 1), {"--far", "0"}), Expect::Image, "",
                          "base", 1e-6, "infinite far plane (the default is 41.6 here)"});
-        cases.push_back({"near_1e-6", m, stage(0, 1, 1e-6), Expect::Image, "", "base", 0.005,
+        cases.push_back({"near_1e-6", m, stage(0, 1, 1e-6), Expect::Image, "", "base", 0.002,
                          "near 1e-6, float depth (reversed-Z keeps the wall at 20)"});
         cases.push_back({"near_1e-5_unorm16", m,
                          with(stage(0, 1, 1e-5), {"--depth-format", "unorm16"}),
