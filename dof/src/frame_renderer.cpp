@@ -295,29 +295,43 @@ raster::Status FrameRenderer::render(const raster::Scene& scene, const raster::V
         settings.seed = m->samples->seed();
         settings.sequence_2n = nullptr;
         if (settings.jitter == JitterMode::Halton) {
-            // §4.5's 2N-sample sequence: a Halton sequence on the same aperture.
-            raster::Result<LensSampleSet> seq =
-                LensSampleSet::create(m->samples->shape(), LensPattern::Halton,
-                                      2 * m->samples->size(), m->samples->seed());
-            if (!seq.ok())
-                return seq.status();
-            sequence_2n_ = std::move(*seq);
+            // §4.5's 2N-sample sequence: a Halton sequence on the same aperture, kept while the
+            // aperture, count and seed stay the same (it is a pure function of them).
+            const LensSampleSet& main = *m->samples;
+            if (!sequence_2n_ || sequence_2n_->size() != 2 * main.size() ||
+                sequence_2n_->seed() != main.seed() ||
+                !sameAperture(sequence_2n_->shape(), main.shape())) {
+                sequence_2n_.reset();
+                raster::Result<LensSampleSet> seq = LensSampleSet::create(
+                    main.shape(), LensPattern::Halton, 2 * main.size(), main.seed());
+                if (!seq.ok())
+                    return seq.status();
+                sequence_2n_ = std::move(*seq);
+            }
             settings.sequence_2n = &*sequence_2n_;
         }
         ShadingInputs shading;
         shading.scene = &scene;
         shading.simd = options.simd;
-        const PinholeFn render_pinhole = [&](const raster::View& v, raster::Frame& f) -> Status {
-            if (&f == &pinhole_ && kept && pinholeMatches(scene, v, options)) {
-                report.pinhole_reused = true;
+        // The callbacks capture two pointers, which std::function stores without allocating.
+        const struct {
+            const raster::Scene& scene;
+            const raster::RenderOptions& options;
+            FrameReport& report;
+            bool kept;
+        } call{scene, options, report, kept};
+        const PinholeFn render_pinhole = [this, &call](const raster::View& v,
+                                                       raster::Frame& f) -> Status {
+            if (&f == &pinhole_ && call.kept && pinholeMatches(call.scene, v, call.options)) {
+                call.report.pinhole_reused = true;
                 return {};
             }
-            return renderPinhole(scene, v, options, f, report);
+            return renderPinhole(call.scene, v, call.options, f, call.report);
         };
-        const LayersFn render_layers = [&](const raster::View& v,
-                                           const raster::LayeredTargetDesc& d,
-                                           raster::LayeredTarget& t) {
-            return renderer_->renderLayers(scene, v, options, d, t);
+        const LayersFn render_layers = [this, &call](const raster::View& v,
+                                                     const raster::LayeredTargetDesc& d,
+                                                     raster::LayeredTarget& t) {
+            return renderer_->renderLayers(call.scene, v, call.options, d, t);
         };
         raster::Result<MultiviewStats> r = renderMultiview(
             view, lens, *m->samples, settings, shading, scene.background, render_pinhole,

@@ -14,9 +14,9 @@ namespace {
 // Margin so that the nearest and farthest visible depths fall strictly inside the bounds.
 constexpr float kRangeMargin = 1e-4f;
 
-LayerSpacing makeSpacing(const ThinLens& lens, const DepthRange& range, uint32_t layers,
-                         float delta_px) {
-    LayerSpacing s;
+void makeSpacing(const ThinLens& lens, const DepthRange& range, uint32_t layers, float delta_px,
+                 LayerSpacing& s) {
+    s.budget_limited = false;
     s.layers = layers;
     s.delta_px = delta_px;
     s.coc_near_px = cocRadiusPx(lens, range.near_d);
@@ -39,7 +39,6 @@ LayerSpacing makeSpacing(const ThinLens& lens, const DepthRange& range, uint32_t
     for (uint32_t l = 1; l <= layers; ++l)
         if (!(s.bounds[l] > s.bounds[l - 1]))
             s.bounds[l] = std::nextafter(s.bounds[l - 1], INFINITY);
-    return s;
 }
 
 Status checkRange(const DepthRange& range) {
@@ -72,8 +71,8 @@ DepthRange visibleDepthRange(const raster::Frame& pinhole, const raster::View& v
     return r;
 }
 
-raster::Result<LayerSpacing> layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range,
-                                                   float delta_px, uint32_t max_layers) {
+Status layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range, float delta_px,
+                             uint32_t max_layers, LayerSpacing& out) {
     if (!std::isfinite(delta_px) || !(delta_px > 0.0f))
         return Status::error("--layer-spacing must be a positive number of pixels");
     if (max_layers == 0)
@@ -91,20 +90,37 @@ raster::Result<LayerSpacing> layerSpacingFromDelta(const ThinLens& lens, const D
         delta = float(span / double(m));
         limited = true;
     }
-    LayerSpacing s = makeSpacing(lens, range, m, delta);
-    s.budget_limited = limited;
-    return s;
+    makeSpacing(lens, range, m, delta, out);
+    out.budget_limited = limited;
+    return {};
 }
 
-raster::Result<LayerSpacing> layerSpacingFromCount(const ThinLens& lens, const DepthRange& range,
-                                                   uint32_t layers) {
+Status layerSpacingFromCount(const ThinLens& lens, const DepthRange& range, uint32_t layers,
+                             LayerSpacing& out) {
     if (layers == 0)
         return Status::error("--layers must be at least 1");
     if (Status st = checkRange(range); !st.ok())
         return st;
     const double span =
         double(cocRadiusPx(lens, range.far_d)) - double(cocRadiusPx(lens, range.near_d));
-    return makeSpacing(lens, range, layers, float(span / double(layers)));
+    makeSpacing(lens, range, layers, float(span / double(layers)), out);
+    return {};
+}
+
+raster::Result<LayerSpacing> layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range,
+                                                   float delta_px, uint32_t max_layers) {
+    LayerSpacing s;
+    if (Status st = layerSpacingFromDelta(lens, range, delta_px, max_layers, s); !st.ok())
+        return st;
+    return s;
+}
+
+raster::Result<LayerSpacing> layerSpacingFromCount(const ThinLens& lens, const DepthRange& range,
+                                                   uint32_t layers) {
+    LayerSpacing s;
+    if (Status st = layerSpacingFromCount(lens, range, layers, s); !st.ok())
+        return st;
+    return s;
 }
 
 uint32_t layerIndex(const ThinLens& lens, const LayerSpacing& spacing, float depth) {

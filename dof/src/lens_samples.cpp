@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace dof {
@@ -183,6 +184,18 @@ std::vector<glm::vec2> primaryPoints(LensPattern pattern, uint32_t count, uint32
             p = rotateModOne(p, shift);
     }
     return points;
+}
+
+bool sameAperture(const ApertureShape& a, const ApertureShape& b) {
+    const auto sameBytes = [](const void* x, const void* y, size_t bytes) {
+        return bytes == 0 || std::memcmp(x, y, bytes) == 0;
+    };
+    return a.kind == b.kind && a.blades == b.blades &&
+           sameBytes(&a.rotation_deg, &b.rotation_deg, sizeof(float)) &&
+           a.mask.width == b.mask.width && a.mask.height == b.mask.height &&
+           a.mask.transmission.size() == b.mask.transmission.size() &&
+           sameBytes(a.mask.transmission.data(), b.mask.transmission.data(),
+                     a.mask.transmission.size() * sizeof(float));
 }
 
 raster::Result<ApertureSampler> ApertureSampler::create(const ApertureShape& shape) {

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -30,7 +31,37 @@ double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// The kept frame state of `scratch`, made by its first frame.
+FrameState& frameState(MultiviewScratch& scratch) {
+    if (!scratch.frame)
+        scratch.frame = std::make_unique<FrameState>();
+    return *scratch.frame;
+}
+
+// The layer spacing (§4.1) and the layered target's description (§4.2) into kept buffers.
+Status layerDesc(const ThinLens& lens, const DepthRange& range, const MultiviewSettings& settings,
+                 LayerSpacing& spacing, raster::LayeredTargetDesc& desc) {
+    const Status st = settings.layers > 0
+                          ? layerSpacingFromCount(lens, range, settings.layers, spacing)
+                          : layerSpacingFromDelta(lens, range, settings.layer_spacing_px,
+                                                  raster::kMaxLayers, spacing);
+    if (!st.ok())
+        return st;
+    desc.bounds = spacing.bounds; // same size: copied in place
+    desc.overlap = settings.overlap;
+    desc.routing = settings.routing;
+    desc.color_format = settings.color_format;
+    desc.depth_format = settings.depth_format;
+    desc.gbuffer = settings.view_dependent || settings.env_map != nullptr;
+    return {};
+}
+
 } // namespace
+
+MultiviewScratch::MultiviewScratch() = default;
+MultiviewScratch::~MultiviewScratch() = default;
+MultiviewScratch::MultiviewScratch(MultiviewScratch&&) noexcept = default;
+MultiviewScratch& MultiviewScratch::operator=(MultiviewScratch&&) noexcept = default;
 
 Status validate(const MultiviewSettings& s, uint32_t sample_count) {
     if (sample_count == 0)
@@ -69,23 +100,15 @@ raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& len
                                                              const DepthRange& range,
                                                              const MultiviewSettings& settings,
                                                              LayerSpacing* spacing_out) {
-    raster::Result<LayerSpacing> sp =
-        settings.layers > 0
-            ? layerSpacingFromCount(lens, range, settings.layers)
-            : layerSpacingFromDelta(lens, range, settings.layer_spacing_px, raster::kMaxLayers);
-    if (!sp.ok())
-        return sp.status();
+    LayerSpacing spacing;
     raster::LayeredTargetDesc desc;
-    desc.bounds = sp->bounds;
-    desc.overlap = settings.overlap;
-    desc.routing = settings.routing;
-    desc.color_format = settings.color_format;
-    desc.depth_format = settings.depth_format;
-    desc.gbuffer = settings.view_dependent || settings.env_map != nullptr;
+    if (Status st = layerDesc(lens, range, settings, spacing, desc); !st.ok())
+        return st;
     if (spacing_out)
-        *spacing_out = std::move(*sp);
+        *spacing_out = std::move(spacing);
     return desc;
 }
+
 raster::Result<MultiviewStats>
 synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
                     const raster::Frame& pinhole, const raster::LayeredTarget& layers,
@@ -117,7 +140,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     stats.budget_limited = spacing.budget_limited;
     stats.layered_bytes = layers.bytes();
 
-    Tracer tr;
+    FrameState& fs = frameState(scratch);
+    Tracer& tr = fs.tracer;
+    tr.reset();
     tr.view = &view;
     tr.lens = &lens;
     tr.samples = &samples;
@@ -145,14 +170,17 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     }
     if (std::isfinite(settings.thickness_px) && tr.coc_b != 0.0f)
         tr.thickness_d = settings.thickness_px / std::fabs(tr.coc_b);
-    tr.lambda = meanNeighbourDistance(samples);
+    // lambda and the cells: measured again only when the sample set changes.
+    const bool cone_cells = settings.cone && settings.cone_centre == ConeCentre::Cell &&
+                            settings.jitter == JitterMode::None;
+    updateLensCells(samples, cone_cells, fs.lens_cells);
+    tr.lambda = fs.lens_cells.lambda;
     stats.lambda = tr.lambda;
     float r_max = 0.0f;
     for (const LensSample& ls : samples.samples())
         r_max = std::max(r_max, glm::length(ls.position));
-    if (settings.cone && settings.cone_centre == ConeCentre::Cell &&
-        settings.jitter == JitterMode::None) {
-        const std::vector<glm::vec2> cells = lensCellOffsets(samples);
+    if (cone_cells) {
+        const std::vector<glm::vec2>& cells = fs.lens_cells.offsets;
         for (uint32_t k = 0; k < cells.size(); ++k) {
             tr.cone_offsets.push_back(lensRayImageOffset(1.0f, cells[k]));
             // The culling windows (and N-buffer levels) bound every cone centre as every ray.
@@ -172,14 +200,14 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     auto t0 = Clock::now();
     const size_t pixels = size_t(width) * height;
     const bool transparency = layers.hasTransparency();
-    const LayerContent content = copyLayerDepths(layers, pool, scratch);
+    copyLayerDepths(layers, pool, scratch, fs.content);
     float reach_max = 0.0f;
-    if (Status st = buildSegments(tr, content, stats, reach_max); !st.ok())
+    if (Status st = buildSegments(tr, fs.content, stats, reach_max); !st.ok())
         return st;
     stats.ms_decomposition = msSince(t0); // the copy belongs to the decomposition's cost
 
     t0 = Clock::now();
-    buildNBuffers(tr, pool, scratch, stats);
+    buildNBuffers(tr, pool, scratch, fs.nearest, stats);
     stats.ms_nbuffer = msSince(t0);
 
     t0 = Clock::now();
@@ -212,10 +240,14 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     rgba.assign(pixels * 4, 0.0f);
     const uint32_t ts = settings.tile_size;
     const uint32_t tiles_x = (width + ts - 1) / ts, tiles_y = (height + ts - 1) / ts;
-    std::vector<TileCounters> counters(size_t(tiles_x) * tiles_y);
-    // Per worker: the states of one tile's rays and pixels.
-    std::vector<RayState> ray_states(size_t(pool.workerCount()) * ts * ts * samples.size());
-    std::vector<PixelLayers> pixel_layers(size_t(pool.workerCount()) * ts * ts);
+    std::vector<TileCounters>& counters = fs.counters;
+    counters.assign(size_t(tiles_x) * tiles_y, TileCounters{});
+    // Per worker: the states of one tile's rays and pixels (as new ones: the same size and
+    // settings reuse the kept buffers).
+    std::vector<RayState>& ray_states = fs.ray_states;
+    ray_states.assign(size_t(pool.workerCount()) * ts * ts * samples.size(), RayState{});
+    std::vector<PixelLayers>& pixel_layers = fs.pixel_layers;
+    pixel_layers.assign(size_t(pool.workerCount()) * ts * ts, PixelLayers{});
     const TraceTileFn trace_tile = traceTileFor(shading.simd);
     pool.parallelFor(tiles_x * tiles_y, [&](uint32_t tile, uint32_t worker) {
         // Counted on the stack, stored once: neighbouring tiles' counters share cache lines,
@@ -307,21 +339,19 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
             stats.d_near = range.near_d, stats.d_far = range.far_d;
         return stats;
     }
-    LayerSpacing spacing;
-    raster::Result<raster::LayeredTargetDesc> desc =
-        multiviewLayerDesc(lens, range, settings, &spacing);
-    if (!desc.ok())
-        return desc.status();
+    MultiviewScratch local_scratch;
+    MultiviewScratch& scratch = scratch_io ? *scratch_io : local_scratch;
+    FrameState& fs = frameState(scratch);
+    if (Status st = layerDesc(lens, range, settings, fs.spacing, fs.desc); !st.ok())
+        return st;
     raster::LayeredTarget local_layers;
     raster::LayeredTarget& layers = layers_out ? *layers_out : local_layers;
     t0 = Clock::now();
-    if (Status st = render_layers(view, *desc, layers); !st.ok())
+    if (Status st = render_layers(view, fs.desc, layers); !st.ok())
         return st;
     const double ms_layers = msSince(t0);
-    MultiviewScratch local_scratch;
-    MultiviewScratch& scratch = scratch_io ? *scratch_io : local_scratch;
     raster::Result<MultiviewStats> r =
-        synthesizeMultiview(view, lens, samples, pinhole, layers, spacing, settings, shading,
+        synthesizeMultiview(view, lens, samples, pinhole, layers, fs.spacing, settings, shading,
                             background, pool, scratch, rgba);
     if (!r.ok())
         return r;

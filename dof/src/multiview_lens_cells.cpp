@@ -1,12 +1,16 @@
 // Multiview's lens cells: the mean nearest-neighbour distance of a lens sample set (the cone
 // width lambda, §4.4) and each sample's Voronoi-cell centroid (ConeCentre::Cell). Consumes a
-// LensSampleSet; produces plain values and vectors the caller owns.
+// LensSampleSet; produces plain values and vectors the caller owns, or keeps them in a
+// LensCells (multiview_setup.h) from frame to frame.
+#include "multiview_setup.h"
+
 #include <dof/multiview.h>
 
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 namespace dof {
@@ -131,5 +135,31 @@ std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fi
             offsets[i] = glm::vec2(sum[i] / weight[i]) - samples.sample(i).position;
     return offsets;
 }
+
+namespace multiview_detail {
+
+void updateLensCells(const LensSampleSet& samples, bool offsets, LensCells& cells) {
+    static_assert(sizeof(LensSample) == 3 * sizeof(float), "compared as bytes: no padding");
+    const std::vector<LensSample>& s = samples.samples();
+    const bool same = cells.valid && cells.key.size() == s.size() &&
+                      (s.empty() || std::memcmp(cells.key.data(), s.data(),
+                                                s.size() * sizeof(LensSample)) == 0) &&
+                      sameAperture(cells.key_shape, samples.shape());
+    if (!same) {
+        // Invalid until every value is the new set's (an allocation may fail on the way).
+        cells.valid = false;
+        cells.has_offsets = false;
+        cells.lambda = meanNeighbourDistance(samples);
+        cells.key = s;
+        cells.key_shape = samples.shape();
+        cells.valid = true;
+    }
+    if (offsets && !cells.has_offsets) {
+        cells.offsets = lensCellOffsets(samples);
+        cells.has_offsets = true;
+    }
+}
+
+} // namespace multiview_detail
 
 } // namespace dof

@@ -40,8 +40,8 @@ RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<
 
 } // namespace
 
-LayerContent copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool,
-                             MultiviewScratch& scratch) {
+void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool,
+                     MultiviewScratch& scratch, LayerContent& content) {
     const uint32_t m = layers.layer_count;
     const size_t pixels = size_t(layers.width) * layers.height;
     const bool transparency = layers.hasTransparency();
@@ -50,8 +50,9 @@ LayerContent copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPo
     // Buffers kept from the caller's previous frame are resized in place, not reallocated: every
     // slot read below is rewritten, and a layer that builds nothing is cleared.
     scratch.nbuffers.resize(m);
-    LayerContent content{std::vector<float>(m, INFINITY), std::vector<float>(m, -INFINITY),
-                         std::vector<uint8_t>(m, 0)};
+    content.min.assign(m, INFINITY);
+    content.max.assign(m, -INFINITY);
+    content.transparent.assign(m, 0);
     pool.parallelFor(m, [&](uint32_t l, uint32_t) {
         float lo = INFINITY, hi = -INFINITY;
         // Returns whether any texel is covered.
@@ -79,7 +80,6 @@ LayerContent copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPo
         content.min[l] = lo;
         content.max[l] = hi;
     });
-    return content;
 }
 
 Status buildSegments(Tracer& tr, const LayerContent& content, MultiviewStats& stats,
@@ -139,7 +139,7 @@ Status buildSegments(Tracer& tr, const LayerContent& content, MultiviewStats& st
 }
 
 void buildNBuffers(const Tracer& tr, raster::TaskPool& pool, MultiviewScratch& scratch,
-                   MultiviewStats& stats) {
+                   std::vector<std::vector<float>>& nearest, MultiviewStats& stats) {
     const MultiviewSettings& settings = *tr.settings;
     const uint32_t width = tr.width, height = tr.height;
     const uint32_t m = uint32_t(tr.segs.size());
@@ -148,6 +148,7 @@ void buildNBuffers(const Tracer& tr, raster::TaskPool& pool, MultiviewScratch& s
     if (!settings.culling)
         scratch.nbuffers.assign(m, NBuffer{});
     if (settings.culling) {
+        nearest.resize(transparency ? m : 0);
         pool.parallelFor(m, [&](uint32_t l, uint32_t) {
             if (tr.segs[l].empty) {
                 scratch.nbuffers[l] = NBuffer{};
@@ -166,10 +167,11 @@ void buildNBuffers(const Tracer& tr, raster::TaskPool& pool, MultiviewScratch& s
             }
             // One N-buffer for both planes: the nearer of the two depths, so culling stays
             // lossless for each.
-            std::vector<float> nearest(pixels);
+            std::vector<float>& source = nearest[l];
+            source.resize(pixels);
             for (size_t i = 0; i < pixels; ++i)
-                nearest[i] = std::min(scratch.depth[l][i], scratch.transparent_depth[l][i]);
-            buildNBuffer(nearest.data(), width, height, level, scratch.nbuffers[l]);
+                source[i] = std::min(scratch.depth[l][i], scratch.transparent_depth[l][i]);
+            buildNBuffer(source.data(), width, height, level, scratch.nbuffers[l]);
         });
         for (uint32_t l = 0; l < m; ++l)
             stats.nbuffer_levels = std::max(stats.nbuffer_levels, scratch.nbuffers[l].levelCount());
@@ -269,18 +271,18 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
                 });
         });
     }
-    auto views = [&](const std::vector<std::vector<std::vector<float>>>& layer_mips) {
-        std::vector<MipChain> chains(layer_mips.size());
+    auto views = [&](const std::vector<std::vector<std::vector<float>>>& layer_mips,
+                     std::vector<MipChain>& chains) {
+        chains.assign(layer_mips.size(), MipChain{});
         for (size_t l = 0; l < layer_mips.size(); ++l)
             for (size_t lv = 0; lv < layer_mips[l].size(); ++lv) {
                 const int64_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
                 chains[l][lv] = {layer_mips[l][lv].data(), w, h, float(w - 1), float(h - 1)};
             }
-        return chains;
     };
-    tr.mips = views(scratch.mips);
-    tr.owned_mips = views(scratch.owned_mips);
-    tr.transparent_mips = views(scratch.transparent_mips);
+    views(scratch.mips, tr.mips);
+    views(scratch.owned_mips, tr.owned_mips);
+    views(scratch.transparent_mips, tr.transparent_mips);
     for (LayerSeg& seg : tr.segs)
         if (seg.cone_px > 0.0f) {
             seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));

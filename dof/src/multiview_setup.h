@@ -17,19 +17,51 @@ struct LayerContent {
     std::vector<uint8_t> transparent; // whether its transparent plane has content
 };
 
+// The lens cells of one sample set (multiview_lens_cells.cpp): lambda (meanNeighbourDistance)
+// and, when asked for, each sample's cell offset (lensCellOffsets). Kept with the set's samples
+// and aperture as the key, so they are measured again only when the set changes.
+struct LensCells {
+    bool valid = false;          // lambda is the key's
+    bool has_offsets = false;    // offsets are the key's (may be empty: no cells)
+    std::vector<LensSample> key; // the set's samples, bit for bit
+    ApertureShape key_shape;     // and its aperture
+    float lambda = 0.0f;
+    std::vector<glm::vec2> offsets;
+};
+
+// Makes `cells` describe `samples` (lambda always, the offsets when `offsets` is set), measuring
+// only what the kept values do not already give.
+void updateLensCells(const LensSampleSet& samples, bool offsets, LensCells& cells);
+
+// Everything of a frame that is not in MultiviewScratch's public buffers (MultiviewScratch::frame):
+// kept between frames, resized in place.
+struct FrameState {
+    LayerSpacing spacing;           // §4.1
+    raster::LayeredTargetDesc desc; // §4.2
+    Tracer tracer;                  // reset() at the start of each frame
+    LayerContent content;
+    std::vector<std::vector<float>> nearest; // per layer: the N-buffer source with BLEND planes
+    LensCells lens_cells;
+    std::vector<TileCounters> counters;    // per output tile
+    std::vector<RayState> ray_states;      // per worker: one tile's rays
+    std::vector<PixelLayers> pixel_layers; // per worker: one tile's pixels
+};
+
 // Per-layer float depths (empty -> kEmptyDepth) into scratch.depth and transparent_depth, and
-// the layers' content extents; one task per layer, each writing only its own slots.
-LayerContent copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool,
-                             MultiviewScratch& scratch);
+// the layers' content extents into `content`; one task per layer, each writing only its own
+// slots.
+void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool,
+                     MultiviewScratch& scratch, LayerContent& content);
 
 // tr.segs from the layer bounds and content; reach_max: the largest reach_px of a non-empty
 // layer. Fails when the lens blurs by more than kMaxReachPx.
 raster::Status buildSegments(Tracer& tr, const LayerContent& content, MultiviewStats& stats,
                              float& reach_max);
 
-// scratch.nbuffers (§4.3 culling; cleared with culling off).
+// scratch.nbuffers (§4.3 culling; cleared with culling off). `nearest`: per-layer buffers for
+// the layers with a transparent plane.
 void buildNBuffers(const Tracer& tr, raster::TaskPool& pool, MultiviewScratch& scratch,
-                   MultiviewStats& stats);
+                   std::vector<std::vector<float>>& nearest, MultiviewStats& stats);
 
 // The coverage, owned and transparent mipmaps (§4.4) in scratch, their views in tr, and each
 // segment's first missed-cone lookup.

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace dof::multiview_detail {
@@ -135,6 +136,24 @@ struct Tracer {
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     bool in_focus = false;        // pixels in focus are resolved without tracing (inFocusPixel)
     glm::vec3 background{0.0f};
+
+    // Every field as a new Tracer's, the vectors emptied with their capacity kept (a Tracer kept
+    // in MultiviewScratch from frame to frame is reset at the start of each).
+    void reset() {
+        Tracer fresh;
+        const auto keep = [](auto& kept, auto& into) {
+            kept.clear();
+            into.swap(kept);
+        };
+        keep(segs, fresh.segs);
+        keep(paths, fresh.paths);
+        keep(cells, fresh.cells);
+        keep(cone_offsets, fresh.cone_offsets);
+        keep(mips, fresh.mips);
+        keep(owned_mips, fresh.owned_mips);
+        keep(transparent_mips, fresh.transparent_mips);
+        *this = std::move(fresh);
+    }
 
     float cocOf(float t) const { return coc_a + coc_b * t; }
     bool inImage(float px, float py) const {

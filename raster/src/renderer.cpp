@@ -33,6 +33,8 @@ struct Renderer::State {
     std::vector<std::vector<FragmentNode>> list_kept;
     // ListSink early rejection: per worker, the k nearest depths of each pixel of its tile.
     std::vector<std::vector<float>> list_nearest;
+    // Layered rendering: the overlapped interval of each layer.
+    std::vector<LayerInterval> layer_intervals;
 };
 
 Renderer::Renderer(TaskPool& pool) : pool_(pool), state_(std::make_unique<State>()) {}
@@ -284,7 +286,8 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     const bool transparent_gbuffer = transparency && desc.gbuffer;
     out.transparent_gbuffer.assign(transparent_gbuffer ? pixels * layers : 0, GSample{});
     out.transparent_top_alpha.assign(transparent_gbuffer ? pixels * layers : 0, 0.0f);
-    std::vector<LayerInterval> intervals(layers);
+    std::vector<LayerInterval>& intervals = st.layer_intervals;
+    intervals.resize(layers);
     for (uint32_t l = 0; l < layers; ++l)
         intervals[l] = overlappedInterval(desc, l);
 

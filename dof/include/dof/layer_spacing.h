@@ -50,6 +50,13 @@ raster::Result<LayerSpacing> layerSpacingFromDelta(const ThinLens& lens, const D
 raster::Result<LayerSpacing> layerSpacingFromCount(const ThinLens& lens, const DepthRange& range,
                                                    uint32_t layers);
 
+// The same two, into `out`: its bounds are resized in place, so a kept LayerSpacing with M+1
+// bounds is filled without allocating. On failure `out` is unspecified.
+raster::Status layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range, float delta_px,
+                                     uint32_t max_layers, LayerSpacing& out);
+raster::Status layerSpacingFromCount(const ThinLens& lens, const DepthRange& range, uint32_t layers,
+                                     LayerSpacing& out);
+
 // Eq. 4: the layer of depth d, clamped to [0, M-1].
 uint32_t layerIndex(const ThinLens& lens, const LayerSpacing& spacing, float depth);
 

@@ -45,6 +45,10 @@ struct ApertureShape {
     ApertureMask mask;         // Image
 };
 
+// The same aperture bit for bit (kind, blades, rotation and mask), so the same pattern, count
+// and seed build the same sample set on both.
+bool sameAperture(const ApertureShape& a, const ApertureShape& b);
+
 struct LensSample {
     glm::vec2 position{0.0f}; // lens units (see top)
     float weight = 1.0f;      // the set's weights sum to 1

@@ -30,6 +30,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -197,8 +198,19 @@ struct MultiviewStats {
     double ms_tracing = 0.0;
 };
 
-// Reusable scratch: per-layer float depths, N-buffers and coverage mipmaps.
+namespace multiview_detail {
+struct FrameState; // multiview_setup.h
+} // namespace multiview_detail
+
+// Reusable scratch: per-layer float depths, N-buffers and coverage mipmaps, and the rest of a
+// frame's buffers. Kept from frame to frame, every buffer is resized in place, so a second frame
+// of the same size, samples and settings allocates nothing (the bytes are those of a fresh one).
 struct MultiviewScratch {
+    MultiviewScratch();
+    ~MultiviewScratch();
+    MultiviewScratch(MultiviewScratch&&) noexcept;
+    MultiviewScratch& operator=(MultiviewScratch&&) noexcept;
+
     std::vector<std::vector<float>> depth; // per layer, stored D; kEmptyDepth where empty
     std::vector<NBuffer> nbuffers;         // per layer (empty when the layer is empty or culling
                                            // is off)
@@ -213,6 +225,11 @@ struct MultiviewScratch {
     // stored D of the nearest BLEND fragment (kEmptyDepth where none) and premultiplied mipmaps.
     std::vector<std::vector<float>> transparent_depth;
     std::vector<std::vector<std::vector<float>>> transparent_mips;
+    // The rest, private to the method: the layer spacing and description, the tracer's segments,
+    // paths and mip views, the tiles' ray states and counters, and the lens cells (lambda and cone
+    // centres) of the last sample set, computed again only when the set changes. Made by the
+    // first frame.
+    std::unique_ptr<multiview_detail::FrameState> frame;
 };
 
 // The layered target's description for a depth range (§4.1 spacing + §4.2 options).
