@@ -1,7 +1,10 @@
+#include "out_of_memory.h"
+
 #include <dof/accum.h>
 
 #include <chrono>
 #include <cstdio>
+#include <new>
 #include <vector>
 
 namespace dof {
@@ -39,7 +42,7 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
                                        const LensSampleSet& samples, const AccumSettings& settings,
                                        const RenderFn& render, raster::Frame& out,
                                        raster::TaskPool* pool, const ProgressFn& progress,
-                                       AccumScratch* kept) {
+                                       AccumScratch* kept) try {
     if (Status s = validate(lens, view); !s.ok())
         return s;
     if (samples.size() == 0)
@@ -126,6 +129,8 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
         out.color[k] = float(acc[k] * inv);
     stats.ms_accumulate += msSince(t0);
     return stats;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("rendering accum");
 }
 
 } // namespace dof

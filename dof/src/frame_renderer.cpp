@@ -1,9 +1,12 @@
+#include "out_of_memory.h"
+
 #include <dof/frame_renderer.h>
 #include <raster/fragment_lists.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <new>
 #include <string>
 #include <type_traits>
 
@@ -132,7 +135,7 @@ raster::Status FrameRenderer::renderPinhole(const raster::Scene& scene, const ra
 raster::Result<const raster::Frame*> FrameRenderer::pinhole(const raster::Scene& scene,
                                                             const raster::View& view,
                                                             const raster::RenderOptions& options,
-                                                            raster::FrameStats* stats) {
+                                                            raster::FrameStats* stats) try {
     pinhole_kept_ = false;
     FrameReport report;
     if (Status s = renderPinhole(scene, pinholeView(view), options, pinhole_, report); !s.ok())
@@ -141,16 +144,29 @@ raster::Result<const raster::Frame*> FrameRenderer::pinhole(const raster::Scene&
         *stats = report.last_render;
     pinhole_kept_ = true;
     return &pinhole_;
+} catch (const std::bad_alloc&) {
+    pinhole_key_.reset();
+    return detail::outOfMemory("rendering the pinhole frame");
 }
 
 raster::Result<ResolvedLens> FrameRenderer::resolveLens(const LensRequest& request,
                                                         const raster::Scene& scene,
                                                         const raster::View& view,
                                                         const raster::RenderOptions& options,
-                                                        raster::FrameStats* stats) {
-    return dof::resolveLens(request, scene, view, [&](const raster::View& v) {
-        return pinhole(scene, v, options, stats);
+                                                        raster::FrameStats* stats) try {
+    // The callback captures two pointers, which std::function stores without allocating.
+    const struct {
+        const raster::Scene& scene;
+        const raster::RenderOptions& options;
+        raster::FrameStats* stats;
+    } call{scene, options, stats};
+    return dof::resolveLens(request, scene, view, [this, &call](const raster::View& v) {
+        return pinhole(call.scene, v, call.options, call.stats);
     });
+} catch (const std::bad_alloc&) {
+    pinhole_key_.reset();
+    pinhole_kept_ = false;
+    return detail::outOfMemory("resolving the lens");
 }
 
 const raster::Frame* FrameRenderer::lastPinhole(const raster::Scene& scene,
@@ -163,6 +179,50 @@ raster::Status FrameRenderer::render(const raster::Scene& scene, const raster::V
                                      const ThinLens& lens, const raster::RenderOptions& options,
                                      const MethodSettings& method, const FrameImage& image,
                                      FrameReport* report_out) {
+    Status s;
+    try {
+        s = renderFrame(scene, view, lens, options, method, image, report_out);
+    } catch (const std::bad_alloc&) {
+        s = detail::outOfMemoryWhile([&] {
+            return std::string("rendering ") + methodName(method) + " at " +
+                   std::to_string(view.width) + "x" + std::to_string(view.height);
+        });
+    }
+    // Out of memory (thrown here or turned into a Status on the way): the method's kept buffers
+    // may be half resized; give them back, as the memory is wanted elsewhere, and the next frame
+    // starts as a first one does.
+    if (detail::isOutOfMemory(s))
+        releaseAfterFailure(method);
+    return s;
+}
+
+void FrameRenderer::releaseAfterFailure(const MethodSettings& method) noexcept {
+    // Moves of empty buffers, which allocate nothing.
+    pinhole_key_.reset();
+    pinhole_kept_ = false;
+    pinhole_ = raster::Frame{};
+    if (std::holds_alternative<AccumMethod>(method)) {
+        accum_ = raster::Frame{};
+        accum_scratch_ = AccumScratch{};
+    } else if (std::holds_alternative<GatherMethod>(method)) {
+        rgba_ = std::vector<float>{};
+        gather_scratch_ = GatherScratch{};
+    } else if (std::holds_alternative<MultiviewMethod>(method)) {
+        rgba_ = std::vector<float>{};
+        layers_ = raster::LayeredTarget{};
+        multiview_scratch_ = MultiviewScratch{};
+        sequence_2n_.reset();
+    } else if (std::holds_alternative<MultilayerMethod>(method)) {
+        multilayer_ = Multilayer{};
+        multilayer_image_ = MultilayerImage{};
+    }
+}
+
+raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const raster::View& view,
+                                          const ThinLens& lens,
+                                          const raster::RenderOptions& options,
+                                          const MethodSettings& method, const FrameImage& image,
+                                          FrameReport* report_out) {
     // The pinhole made by pinhole() serves this frame only.
     const bool kept = pinhole_kept_;
     pinhole_kept_ = false;

@@ -1,3 +1,5 @@
+#include "out_of_memory.h"
+
 #include <dof/gather.h>
 
 #include <algorithm>
@@ -5,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <new>
 #include <string>
 
 #if defined(__SSE2__) && !defined(FOCAL_NO_SIMD)
@@ -273,7 +276,7 @@ Status badInput(const GatherImage& image, size_t index, bool bad_depth) {
 Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const raster::View& view,
                            const GatherSettings& settings, std::vector<float>& out_rgba,
                            std::vector<float>* out_coc, raster::TaskPool* pool,
-                           GatherScratch* scratch) {
+                           GatherScratch* scratch) try {
     if (Status st = checkAll(image, lens, view, settings); !st.ok())
         return st;
     GatherScratch local;
@@ -518,11 +521,13 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
         stats.tiles_copied += copied_v[t] & copied_h[t];
     }
     return stats;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("running gather");
 }
 
 Result<GatherStats> gatherReference(const GatherImage& image, const ThinLens& lens,
                                     const raster::View& view, const GatherSettings& settings,
-                                    std::vector<float>& out_rgba) {
+                                    std::vector<float>& out_rgba) try {
     if (Status st = checkAll(image, lens, view, settings); !st.ok())
         return st;
     const uint32_t w = image.width, h = image.height;
@@ -575,6 +580,8 @@ Result<GatherStats> gatherReference(const GatherImage& image, const ThinLens& le
     pass(input, vertical, true);
     pass(vertical, out_rgba, false);
     return stats;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("running the gather reference");
 }
 
 } // namespace dof

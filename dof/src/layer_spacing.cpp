@@ -1,8 +1,11 @@
+#include "out_of_memory.h"
+
 #include <dof/layer_spacing.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <new>
 #include <string>
 
 namespace dof {
@@ -72,7 +75,7 @@ DepthRange visibleDepthRange(const raster::Frame& pinhole, const raster::View& v
 }
 
 Status layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range, float delta_px,
-                             uint32_t max_layers, LayerSpacing& out) {
+                             uint32_t max_layers, LayerSpacing& out) try {
     if (!std::isfinite(delta_px) || !(delta_px > 0.0f))
         return Status::error("--layer-spacing must be a positive number of pixels");
     if (max_layers == 0)
@@ -93,10 +96,12 @@ Status layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range, floa
     makeSpacing(lens, range, m, delta, out);
     out.budget_limited = limited;
     return {};
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("spacing the layers");
 }
 
 Status layerSpacingFromCount(const ThinLens& lens, const DepthRange& range, uint32_t layers,
-                             LayerSpacing& out) {
+                             LayerSpacing& out) try {
     if (layers == 0)
         return Status::error("--layers must be at least 1");
     if (Status st = checkRange(range); !st.ok())
@@ -105,22 +110,28 @@ Status layerSpacingFromCount(const ThinLens& lens, const DepthRange& range, uint
         double(cocRadiusPx(lens, range.far_d)) - double(cocRadiusPx(lens, range.near_d));
     makeSpacing(lens, range, layers, float(span / double(layers)), out);
     return {};
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("spacing the layers");
 }
 
 raster::Result<LayerSpacing> layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range,
-                                                   float delta_px, uint32_t max_layers) {
+                                                   float delta_px, uint32_t max_layers) try {
     LayerSpacing s;
     if (Status st = layerSpacingFromDelta(lens, range, delta_px, max_layers, s); !st.ok())
         return st;
     return s;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("spacing the layers");
 }
 
 raster::Result<LayerSpacing> layerSpacingFromCount(const ThinLens& lens, const DepthRange& range,
-                                                   uint32_t layers) {
+                                                   uint32_t layers) try {
     LayerSpacing s;
     if (Status st = layerSpacingFromCount(lens, range, layers, s); !st.ok())
         return st;
     return s;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("spacing the layers");
 }
 
 uint32_t layerIndex(const ThinLens& lens, const LayerSpacing& spacing, float depth) {

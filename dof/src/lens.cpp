@@ -1,7 +1,10 @@
+#include "out_of_memory.h"
+
 #include <dof/lens.h>
 
 #include <cmath>
 #include <cstdio>
+#include <new>
 #include <string>
 
 namespace dof {
@@ -64,7 +67,7 @@ Status validate(const ThinLens& lens, const raster::View& view) {
 }
 
 raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const raster::View& view,
-                                           uint32_t x, uint32_t y) {
+                                           uint32_t x, uint32_t y) try {
     if (x >= pinhole.width || y >= pinhole.height)
         return Status::error("focus_pixel " + std::to_string(x) + "," + std::to_string(y) +
                              " lies outside the " + std::to_string(pinhole.width) + "x" +
@@ -75,6 +78,8 @@ raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const r
         return Status::error("focus_pixel " + std::to_string(x) + "," + std::to_string(y) +
                              " shows only background; there is no depth to focus on");
     return d;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("reading the focus distance");
 }
 
 CocRange visibleCocRange(const ThinLens& lens, const raster::Frame& pinhole,

@@ -1,9 +1,12 @@
+#include "out_of_memory.h"
+
 #include <dof/lens_resolution.h>
 
 #include <glm/geometric.hpp>
 
 #include <chrono>
 #include <cmath>
+#include <new>
 #include <string>
 
 namespace dof {
@@ -64,7 +67,9 @@ raster::Result<std::optional<float>> pinholeFocus(const LensRequest& request,
     const glm::uvec2 at =
         request.focus_pixel.value_or(glm::uvec2(r.view.width / 2, r.view.height / 2));
     raster::Result<float> d = focusDistanceAtPixel(**frame, r.view, at.x, at.y);
-    if (request.focus_pixel && !d.ok())
+    // Without a focus pixel, a centre without depth falls back to the bounds; running out of
+    // memory does not.
+    if ((request.focus_pixel || detail::isOutOfMemory(d.status())) && !d.ok())
         return d.status();
     return d.ok() ? std::optional<float>(*d) : std::nullopt;
 }
@@ -136,7 +141,8 @@ raster::View photographicView(const raster::View& view, const LensRequest& reque
 }
 
 raster::Result<ResolvedLens> resolveLens(const LensRequest& request, const raster::Scene& scene,
-                                         const raster::View& view, const PinholeSource& pinhole) {
+                                         const raster::View& view,
+                                         const PinholeSource& pinhole) try {
     if (Status s = validate(request); !s.ok())
         return s;
     ResolvedLens r;
@@ -152,6 +158,8 @@ raster::Result<ResolvedLens> resolveLens(const LensRequest& request, const raste
         if (Status s = validate(r.lens, r.view); !s.ok())
             return s;
     return r;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("resolving the lens");
 }
 
 } // namespace dof

@@ -1,9 +1,12 @@
+#include "out_of_memory.h"
+
 #include <dof/lens_samples.h>
 #include <raster/hash.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <new>
 #include <string>
 
 namespace dof {
@@ -198,7 +201,7 @@ bool sameAperture(const ApertureShape& a, const ApertureShape& b) {
                      a.mask.transmission.size() * sizeof(float));
 }
 
-raster::Result<ApertureSampler> ApertureSampler::create(const ApertureShape& shape) {
+raster::Result<ApertureSampler> ApertureSampler::create(const ApertureShape& shape) try {
     ApertureSampler s;
     s.shape_ = shape;
     if (shape.kind == ApertureKind::Polygon) {
@@ -235,6 +238,8 @@ raster::Result<ApertureSampler> ApertureSampler::create(const ApertureShape& sha
             return Status::error("aperture image transmits no light (every pixel is 0)");
     }
     return s;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("building the aperture sampler");
 }
 
 glm::vec2 ApertureSampler::map(glm::vec2 u) const {
@@ -288,7 +293,7 @@ glm::vec2 ApertureSampler::map(glm::vec2 u) const {
 }
 
 raster::Result<LensSampleSet> LensSampleSet::create(const ApertureShape& shape, LensPattern pattern,
-                                                    uint32_t count, uint32_t seed) {
+                                                    uint32_t count, uint32_t seed) try {
     if (count == 0)
         return Status::error("--samples must be at least 1");
     raster::Result<ApertureSampler> sampler = ApertureSampler::create(shape);
@@ -305,6 +310,8 @@ raster::Result<LensSampleSet> LensSampleSet::create(const ApertureShape& shape, 
     for (uint32_t i = 0; i < count; ++i)
         set.samples_[i] = {set.sampler_.map(set.primary_[i]), w};
     return set;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("building the lens samples");
 }
 
 LensSample LensSampleSet::sample(uint32_t x, uint32_t y, uint32_t index) const {

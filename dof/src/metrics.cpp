@@ -1,3 +1,5 @@
+#include "out_of_memory.h"
+
 #include <dof/metrics.h>
 #include <raster/check.h>
 
@@ -5,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <string>
 
 namespace dof {
@@ -87,7 +90,7 @@ double srgbEncode(double linear) {
 }
 
 raster::Result<ErrorMetrics> compareImages(const ImageRef& a, const ImageRef& b,
-                                           const std::vector<uint8_t>* mask) {
+                                           const std::vector<uint8_t>* mask) try {
     if (a.width != b.width || a.height != b.height)
         return Status::error("images differ in size: " + std::to_string(a.width) + "x" +
                              std::to_string(a.height) + " vs " + std::to_string(b.width) + "x" +
@@ -165,6 +168,8 @@ raster::Result<ErrorMetrics> compareImages(const ImageRef& a, const ImageRef& b,
     m.ssim = m.ssim_windows ? ssim_sum / double(m.ssim_windows)
                             : std::numeric_limits<double>::quiet_NaN();
     return m;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("comparing images");
 }
 
 uint64_t countDifferingPixels(const ImageRef& a, const ImageRef& b, float tolerance) {

@@ -5,6 +5,7 @@
 // scratch is the caller's MultiviewScratch or a local one.
 #include "multiview_setup.h"
 #include "multiview_tracer.h"
+#include "out_of_memory.h"
 
 #include <dof/multiview.h>
 #include <raster/surface_shading.h>
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 
@@ -99,7 +101,7 @@ Status validate(const MultiviewSettings& s, uint32_t sample_count) {
 raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& lens,
                                                              const DepthRange& range,
                                                              const MultiviewSettings& settings,
-                                                             LayerSpacing* spacing_out) {
+                                                             LayerSpacing* spacing_out) try {
     LayerSpacing spacing;
     raster::LayeredTargetDesc desc;
     if (Status st = layerDesc(lens, range, settings, spacing, desc); !st.ok())
@@ -107,6 +109,8 @@ raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& len
     if (spacing_out)
         *spacing_out = std::move(spacing);
     return desc;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("describing the multiview layers");
 }
 
 raster::Result<MultiviewStats>
@@ -114,7 +118,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                     const raster::Frame& pinhole, const raster::LayeredTarget& layers,
                     const LayerSpacing& spacing, const MultiviewSettings& settings,
                     const ShadingInputs& shading, glm::vec3 background, raster::TaskPool& pool,
-                    MultiviewScratch& scratch, std::vector<float>& rgba) {
+                    MultiviewScratch& scratch, std::vector<float>& rgba) try {
     if (Status st = validate(settings, samples.size()); !st.ok())
         return st;
     if (Status st = validate(lens, view); !st.ok())
@@ -289,6 +293,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     }
     stats.ms_tracing = msSince(t0);
     return stats;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("synthesizing multiview");
 }
 
 raster::Result<MultiviewStats>
@@ -297,7 +303,7 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
                 glm::vec3 background, const PinholeFn& render_pinhole,
                 const LayersFn& render_layers, raster::TaskPool& pool, std::vector<float>& rgba,
                 raster::Frame* pinhole_out, raster::LayeredTarget* layers_out,
-                MultiviewScratch* scratch_io) {
+                MultiviewScratch* scratch_io) try {
     if (Status st = validate(settings, samples.size()); !st.ok())
         return st;
     if (Status st = validate(lens, view); !st.ok())
@@ -360,6 +366,8 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     r->d_near = range.near_d;
     r->d_far = range.far_d;
     return r;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("rendering multiview");
 }
 
 uint64_t multiviewMinimumBytes(const MultiviewSettings& settings, uint32_t width, uint32_t height,

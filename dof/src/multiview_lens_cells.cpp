@@ -3,6 +3,7 @@
 // LensSampleSet; produces plain values and vectors the caller owns, or keeps them in a
 // LensCells (multiview_setup.h) from frame to frame.
 #include "multiview_setup.h"
+#include "out_of_memory.h"
 
 #include <dof/multiview.h>
 
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <new>
 #include <vector>
 
 namespace dof {
@@ -118,6 +120,8 @@ std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fi
         return {};
     raster::Result<LensSampleSet> fine =
         LensSampleSet::create(samples.shape(), LensPattern::Hammersley, fine_count, 0);
+    if (detail::isOutOfMemory(fine.status()))
+        throw std::bad_alloc(); // as the vectors below would: not a reason to drop the cells
     if (!fine.ok())
         return {}; // the shape built the main set, so it builds this one too
     std::vector<glm::vec2> offsets(n, glm::vec2(0.0f));

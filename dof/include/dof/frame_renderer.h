@@ -124,18 +124,21 @@ public:
     // change the image (resolveLens returns a view whose copy agrees). Fails with a Status naming
     // the problem on a null image, a stride below the row size, an invalid view, lens or settings,
     // a missing sample set or a failed render (memory budget, textures); the image may then be
-    // partly written. Not reentrant: one call at a time per object (the work itself runs on the
-    // pool).
+    // partly written. Running out of memory anywhere in the frame is a Status too ("out of
+    // memory while ..."), never an exception: this object then releases the method's kept
+    // buffers and the pinhole frame, and the next call renders as a first frame does. Not
+    // reentrant: one call at a time per object (the work itself runs on the pool).
     [[nodiscard]] raster::Status render(const raster::Scene& scene, const raster::View& view,
                                         const ThinLens& lens, const raster::RenderOptions& options,
                                         const MethodSettings& method, const FrameImage& image,
                                         FrameReport* report = nullptr);
 
     // Renders the pinhole frame of `view` (lens centre) now, e.g. to choose the focus distance,
-    // and keeps it for the next render() call: when that call has the same scene, the same view
-    // (its focus distance aside, which does not move a pinhole's pixels) and the same options,
-    // every method uses this frame instead of rendering it again. render() then drops it, so the
-    // next frame renders the scene again. Valid until the next call on this object.
+    // and keeps it for the next render() call (out of memory: a Status, as in render()): when that
+    // call has the same scene, the same view (its focus distance aside, which does not move a
+    // pinhole's pixels) and the same options, every method uses this frame instead of rendering it
+    // again. render() then drops it, so the next frame renders the scene again. Valid until the
+    // next call on this object.
     [[nodiscard]] raster::Result<const raster::Frame*> pinhole(const raster::Scene& scene,
                                                                const raster::View& view,
                                                                const raster::RenderOptions& options,
@@ -169,6 +172,12 @@ private:
     };
     bool pinholeMatches(const raster::Scene& scene, const raster::View& view,
                         const raster::RenderOptions& options) const;
+    raster::Status renderFrame(const raster::Scene& scene, const raster::View& view,
+                               const ThinLens& lens, const raster::RenderOptions& options,
+                               const MethodSettings& method, const FrameImage& image,
+                               FrameReport* report);
+    // After running out of memory: drops the pinhole frame and `method`'s kept buffers.
+    void releaseAfterFailure(const MethodSettings& method) noexcept;
     raster::Status renderPinhole(const raster::Scene& scene, const raster::View& view,
                                  const raster::RenderOptions& options, raster::Frame& out,
                                  FrameReport& report);
