@@ -244,7 +244,10 @@ TEST(FrameRendererAllocations, SecondIdenticalFramePerMethod) {
                         static_cast<unsigned long long>(c.allocations),
                         static_cast<unsigned long long>(c.bytes));
         }
-        for (const auto& [name, method] : methods) {
+        for (const auto& entry : methods) {
+            // Not a structured binding: clang 14 cannot capture one in the lambdas below.
+            const std::string& name = entry.first;
+            const dof::MethodSettings& method = entry.second;
             dof::FrameRenderer frames(pool);
             dof::FrameReport report;
             ASSERT_TRUE(frames.render(*scene, view, lens, {}, method, image, &report).ok());
@@ -280,7 +283,9 @@ TEST(FrameRendererAllocations, FailedAllocationIsAStatus) {
     Case c;
     for (uint32_t threads : {0u, 2u}) {
         raster::TaskPool pool(threads);
-        for (const auto& [name, method] : c.methods) {
+        for (const auto& entry : c.methods) {
+            const std::string& name = entry.first;
+            const dof::MethodSettings& method = entry.second;
             uint64_t clean = 0, first = 0;
             {
                 dof::FrameRenderer frames(pool);
