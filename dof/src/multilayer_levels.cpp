@@ -124,9 +124,12 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
                 raster::TaskPool& pool, FragmentLevel& out, Needed&& needed, RowMerge&& row_merge) {
     out.rows.resize(out.height);
     out.starts.assign(size_t(out.height) * (out.width + 1), 0);
-    std::vector<uint32_t> longest(out.height, 0);
-    std::vector<uint64_t> dropped(out.height, 0);
-    std::vector<uint64_t> skipped(out.height, 0);
+    std::vector<uint32_t>& longest = out.scratch.longest;
+    std::vector<uint64_t>& dropped = out.scratch.dropped;
+    std::vector<uint64_t>& skipped = out.scratch.skipped;
+    longest.assign(out.height, 0);
+    dropped.assign(out.height, 0);
+    skipped.assign(out.height, 0);
     pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
         std::vector<LayerFragment>& row = out.rows[j];
         row.clear();
@@ -220,9 +223,19 @@ std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const Lev
 LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
                           double aperture_second_moment) {
     LevelBorders t;
+    levelBorders(lens, level_variance, aperture_second_moment, t);
+    return t;
+}
+
+void levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
+                  double aperture_second_moment, LevelBorders& t) {
     t.levels = level_variance.empty() ? 0 : uint32_t(level_variance.size() - 1);
     t.second_moment = aperture_second_moment;
     t.variance = level_variance;
+    t.radius.clear();
+    t.z_near.clear();
+    t.z_far.clear();
+    t.segments.clear();
     const double k = double(lens.aperture_radius) * double(lens.focal_length_px); // E f_px
     const double inv_f = 1.0 / double(lens.focus_distance);
     const float inf = std::numeric_limits<float>::infinity();
@@ -248,7 +261,7 @@ LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level
     };
     if (n == 0) {
         add(0.0f, inf, 0, 0);
-        return t;
+        return;
     }
     add(0.0f, t.z_near[n], n, n);
     for (uint32_t s = n - 1; s >= 1; --s)
@@ -257,7 +270,6 @@ LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level
     for (uint32_t s = 1; s < n; ++s)
         add(t.z_far[s], t.z_far[s + 1], s, s + 1);
     add(t.z_far[n], inf, n, n);
-    return t;
 }
 
 float levelBlend(const LevelBorders& borders, const ThinLens& lens,
@@ -280,7 +292,8 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
     out.height = lists.height;
     out.rows.resize(lists.height);
     out.starts.assign(size_t(lists.height) * (lists.width + 1), 0);
-    std::vector<uint32_t> longest(lists.height, 0);
+    std::vector<uint32_t>& longest = out.scratch.longest;
+    longest.assign(lists.height, 0);
     pool.parallelFor(lists.height, [&](uint32_t y, uint32_t) {
         std::vector<LayerFragment>& row = out.rows[y];
         row.clear();
@@ -302,7 +315,8 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
         starts[lists.width] = uint32_t(row.size());
         longest[y] = row_longest;
     });
-    const std::vector<uint64_t> none(lists.height, 0);
+    std::vector<uint64_t>& none = out.scratch.dropped;
+    none.assign(lists.height, 0);
     sumRows(longest, none, none, out);
 }
 
@@ -382,8 +396,10 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
     // flagged, then the flags are widened by the taps' reach, along x on every box row
     // (near_x) and along y per cell (the G x G square: a superset of the taps with weight).
     const float scale = 1.0f + plan.epsilon;
-    std::vector<uint8_t> flag(reads ? size_t(box.width) * box.height : 0);
-    std::vector<uint8_t> near_x(reads ? size_t(box.height) * out.width : 0);
+    std::vector<uint8_t>& flag = out.scratch.flag;
+    std::vector<uint8_t>& near_x = out.scratch.near_x;
+    flag.resize(reads ? size_t(box.width) * box.height : 0);
+    near_x.resize(reads ? size_t(box.height) * out.width : 0);
     // (Sizes and pointers are copied into locals: the byte stores below may alias them.)
     const uint32_t box_width = box.width;
     const uint32_t out_width = out.width;
@@ -435,8 +451,10 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
         return false;
     };
     // Every box row's list starts and fragments, looked up once instead of per tap.
-    std::vector<const uint32_t*> row_starts(box.height);
-    std::vector<const LayerFragment*> row_data(box.height);
+    std::vector<const uint32_t*>& row_starts = out.scratch.row_starts;
+    std::vector<const LayerFragment*>& row_data = out.scratch.row_data;
+    row_starts.resize(box.height);
+    row_data.resize(box.height);
     for (uint32_t y = 0; y < box.height; ++y) {
         row_starts[y] = box.starts.data() + size_t(y) * (box.width + 1);
         row_data[y] = box.rows[y].data();
