@@ -63,17 +63,25 @@ void mergeTaps(const LayerFragment** next, const LayerFragment* const* end, cons
             const LayerFragment* f = next[k];
             if (!(f->depth <= limit))
                 continue;
-            // Within list k, front to back (§5.1, first case).
+            // Within list k, front to back (§5.1, first case). A list of one fragment (the
+            // common case) takes its first step only, with pa = 0.
             float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
-            do {
-                const float t = shareInList(*f, kPieces, pa);
+            if (end[k] - f == 1) {
+                const float t = shareInList(*f, kPieces, 0.0f);
                 pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
                 pd += t * f->a * f->depth;
-                ++f;
-            } while (f != end[k] && f->depth <= limit);
-            next[k] = f;
-            if (f == end[k])
                 live &= ~(uint64_t{1} << k);
+            } else {
+                do {
+                    const float t = shareInList(*f, kPieces, pa);
+                    pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
+                    pd += t * f->a * f->depth;
+                    ++f;
+                } while (f != end[k] && f->depth <= limit);
+                next[k] = f;
+                if (f == end[k])
+                    live &= ~(uint64_t{1} << k);
+            }
             // Additive blending across lists (§5.1, second case), weighted.
             const float w = weight[k];
             merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
@@ -422,33 +430,49 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
     pool.parallelFor(reads ? box.height : 0, [&](uint32_t y, uint32_t) {
         const uint8_t* f = flag.data() + size_t(y) * box_width;
         uint8_t* o = near_x.data() + size_t(y) * out_width;
-        for (uint32_t i = 0; i < out_width; ++i) {
+        // Inside, no column is clamped: the OR of the shifted flag rows (vectorised); at the
+        // borders, clamped columns.
+        const int32_t lo = std::min(reach, int32_t(out_width));
+        const int32_t hi = std::max(lo, max_x + 1); // [lo, hi) inside
+        for (int32_t i = lo; i < hi; ++i)
+            o[i] = 0;
+        for (int32_t a = 0; a <= reach; a += step) {
+            const uint8_t* src = f + a - reach;
+            for (int32_t i = lo; i < hi; ++i)
+                o[i] |= src[i];
+        }
+        for (int32_t i = 0; i < int32_t(out_width); ++i) {
+            if (i == lo)
+                i = hi;
+            if (i >= int32_t(out_width))
+                break;
             uint8_t any = 0;
-            if (int32_t(i) >= reach && int32_t(i) <= max_x) {
-                for (int32_t a = 0; a <= reach; a += step)
-                    any |= f[int32_t(i) + a - reach];
-            } else {
-                for (int32_t a = 0; a <= reach; a += step)
-                    any |= f[std::clamp(int32_t(i) + a - reach, 0, max_x)];
-            }
+            for (int32_t a = 0; a <= reach; a += step)
+                any |= f[std::clamp(i + a - reach, 0, max_x)];
             o[i] = any;
         }
     });
-    struct Window {
-        uint32_t x0, x1, y0, y1;
-    };
-    const Window window = reads ? Window{reads->x0, reads->x1, reads->y0, reads->y1} : Window{};
-    const uint8_t* near = near_x.data();
-    const auto needed = [window, near, out_width, reach, step, max_y, all = !reads](uint32_t i,
-                                                                                    uint32_t j) {
-        if (all)
-            return true;
-        if (i < window.x0 || i > window.x1 || j < window.y0 || j > window.y1)
-            return false;
-        for (int32_t b = 0; b <= reach; b += step)
-            if (near[size_t(std::clamp(int32_t(j) + b - reach, 0, max_y)) * out_width + i])
-                return true;
-        return false;
+    // The cells to merge: inside the reads' window, with a flag within the taps' reach along
+    // y (the OR of near_x's rows, vectorised), one byte per cell.
+    std::vector<uint8_t>& need = out.scratch.need;
+    need.resize(reads ? size_t(out.height) * out_width : 0);
+    pool.parallelFor(reads ? out.height : 0, [&](uint32_t j, uint32_t) {
+        uint8_t* o = need.data() + size_t(j) * out_width;
+        std::fill(o, o + out_width, uint8_t{0});
+        if (j < reads->y0 || j > reads->y1 || reads->x0 > reads->x1)
+            return;
+        const uint32_t x0 = reads->x0;
+        const uint32_t x1 = std::min(reads->x1, out_width - 1);
+        for (int32_t b = 0; b <= reach; b += step) {
+            const uint8_t* src =
+                near_x.data() + size_t(std::clamp(int32_t(j) + b - reach, 0, max_y)) * out_width;
+            for (uint32_t i = x0; i <= x1; ++i)
+                o[i] |= src[i];
+        }
+    });
+    const uint8_t* need_map = need.data();
+    const auto needed = [need_map, out_width, all = !reads](uint32_t i, uint32_t j) {
+        return all || need_map[size_t(j) * out_width + i] != 0;
     };
     // Every box row's list starts and fragments, looked up once instead of per tap.
     std::vector<const uint32_t*>& row_starts = out.scratch.row_starts;

@@ -88,6 +88,7 @@ struct FragmentLevel {
         std::vector<uint64_t> skipped;
         std::vector<uint8_t> flag;
         std::vector<uint8_t> near_x;
+        std::vector<uint8_t> need;
         std::vector<const uint32_t*> row_starts;
         std::vector<const LayerFragment*> row_data;
     };
