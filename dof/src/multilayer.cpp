@@ -15,12 +15,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The bilinear taps of one level along one axis for every pixel: cells i0, i1 with weight of i1.
-struct AxisTap {
-    uint32_t i0 = 0;
-    uint32_t i1 = 0;
-    float f = 0.0f;
-};
+using AxisTap = Multilayer::AxisTap;
 
 // The cells [lo, hi] that taps with a weight > 0 read along one axis.
 void readRange(const std::vector<AxisTap>& taps, uint32_t& lo, uint32_t& hi) {
@@ -34,8 +29,10 @@ void readRange(const std::vector<AxisTap>& taps, uint32_t& lo, uint32_t& hi) {
     }
 }
 
-std::vector<AxisTap> axisTaps(uint32_t pixels, float origin, float spacing, uint32_t cells) {
-    std::vector<AxisTap> taps(pixels);
+// The bilinear taps of one level along one axis for every pixel (into `taps`, kept).
+void axisTaps(uint32_t pixels, float origin, float spacing, uint32_t cells,
+              std::vector<AxisTap>& taps) {
+    taps.resize(pixels);
     const int64_t last = int64_t(cells) - 1;
     for (uint32_t p = 0; p < pixels; ++p) {
         const double u = (double(p) + 0.5 - double(origin)) / double(spacing);
@@ -45,16 +42,14 @@ std::vector<AxisTap> axisTaps(uint32_t pixels, float origin, float spacing, uint
         taps[p].i1 = uint32_t(std::clamp<int64_t>(i + 1, 0, last));
         taps[p].f = float(u - fl);
     }
-    return taps;
 }
 
 // A list being traversed: level `level`, bilinear weight, cursor.
+// A list being traversed: its next fragment, its end, and the bilinear weight.
 struct Cursor {
-    const LayerFragment* data = nullptr;
-    uint32_t count = 0;
-    uint32_t next = 0;
+    const LayerFragment* next = nullptr;
+    const LayerFragment* end = nullptr;
     float weight = 0.0f;
-    bool pieces = false; // a filtered level's cell (shareInList)
 };
 
 // The rows of cells a level's bilinear taps read on one row of pixels: cell row j0 with weight
@@ -191,9 +186,11 @@ uint32_t firstReader(const Plan& p, uint32_t box) {
 void adoptGeometry(const FragmentLevel& geometry, FragmentLevel& level) {
     std::vector<std::vector<LayerFragment>> rows = std::move(level.rows);
     std::vector<uint32_t> starts = std::move(level.starts);
+    FragmentLevel::Scratch scratch = std::move(level.scratch);
     level = geometry;
     level.rows = std::move(rows);
     level.starts = std::move(starts);
+    level.scratch = std::move(scratch);
 }
 
 MultilayerLevelStats levelStats(const FragmentLevel& l) {
@@ -303,8 +300,10 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     if (levels_.empty())
         levels_.resize(1);
     makeBaseLevel(lists, view, pool, levels_[0]);
-    std::vector<float> row_min(height, std::numeric_limits<float>::infinity());
-    std::vector<float> row_max(height, 0.0f);
+    std::vector<float>& row_min = row_min_;
+    std::vector<float>& row_max = row_max_;
+    row_min.assign(height, std::numeric_limits<float>::infinity());
+    row_max.assign(height, 0.0f);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
         float lo = row_min[y], hi = row_max[y]; // stored once: neighbouring rows share lines
         for (const LayerFragment& f : levels_[0].rows[y]) {
@@ -325,32 +324,51 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     // filter stage, which they belong to).
     t0 = std::chrono::steady_clock::now();
     const bool shaped = settings.filter == LevelFilter::Aperture;
-    std::vector<ApertureGrid> grids[2]; // [far, near], one per settings.aperture_grids
+    std::vector<ApertureGrid>(&grids)[2] = grids_; // [far, near], one per aperture_grids
     double m2 = settings.aperture_second_moment;
     bool asymmetric = false;
     if (shaped) {
-        // One set of samples for every grid: making it costs more than binning it.
-        raster::Result<LensSampleSet> samples = apertureGridSamples(settings.aperture);
-        if (!samples.ok())
-            return raster::Status::error("multilayer: " + samples.status().message());
-        for (uint32_t size : settings.aperture_grids)
-            for (FocalSide side : {FocalSide::Far, FocalSide::Near}) {
-                raster::Result<ApertureGrid> r =
-                    apertureGrid(*samples, settings.aperture, size, side);
-                if (!r.ok())
-                    return raster::Status::error("multilayer: " + r.status().message());
-                grids[side == FocalSide::Far ? 0 : 1].push_back(std::move(*r));
-            }
-        m2 = grids[0][0].second_moment;
-        for (size_t g = 0; g < grids[0].size(); ++g)
-            asymmetric = asymmetric || !sameWeights(grids[0][g], grids[1][g]);
+        // The grids are a pure function of the shape and the sizes: the last frame's are kept.
+        const ApertureShape& a = settings.aperture;
+        const ApertureShape& b = grid_shape_;
+        const bool same = !grids_[0].empty() && grid_sizes_ == settings.aperture_grids &&
+                          a.kind == b.kind && a.blades == b.blades &&
+                          a.rotation_deg == b.rotation_deg && a.mask.width == b.mask.width &&
+                          a.mask.height == b.mask.height &&
+                          a.mask.transmission == b.mask.transmission;
+        if (!same) {
+            grids[0].clear();
+            grids[1].clear();
+            // One set of samples for every grid: making it costs more than binning it.
+            raster::Result<LensSampleSet> samples = apertureGridSamples(settings.aperture);
+            if (!samples.ok())
+                return raster::Status::error("multilayer: " + samples.status().message());
+            for (uint32_t size : settings.aperture_grids)
+                for (FocalSide side : {FocalSide::Far, FocalSide::Near}) {
+                    raster::Result<ApertureGrid> r =
+                        apertureGrid(*samples, settings.aperture, size, side);
+                    if (!r.ok()) {
+                        grids[0].clear();
+                        return raster::Status::error("multilayer: " + r.status().message());
+                    }
+                    grids[side == FocalSide::Far ? 0 : 1].push_back(std::move(*r));
+                }
+            grid_shape_ = settings.aperture;
+            grid_sizes_ = settings.aperture_grids;
+            grid_m2_ = grids[0][0].second_moment;
+            grid_asymmetric_ = false;
+            for (size_t g = 0; g < grids[0].size(); ++g)
+                grid_asymmetric_ = grid_asymmetric_ || !sameWeights(grids[0][g], grids[1][g]);
+        }
+        m2 = grid_m2_;
+        asymmetric = grid_asymmetric_;
     }
 
     // §5: plan the Y-map and T, compute the border table (§6.1).
     Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
     if (raster::Status s = checkLevelMemory(plan, settings, max_coc); !s.ok())
         return s;
-    borders_ = levelBorders(lens, plan.variance, m2);
+    levelBorders(lens, plan.variance, m2, borders_);
     // Box levels up to the highest one T reads (all of them with box levels), then the
     // aperture levels, far side then (asymmetric aperture) near side.
     uint32_t boxes_needed = uint32_t(plan.boxes.size());
@@ -376,7 +394,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     }
     // T as segments; with an asymmetric aperture the one across the focal plane is split there,
     // so that every slice reads the levels of its own side.
-    std::vector<LevelBorders::Segment> segments;
+    std::vector<LevelBorders::Segment>& segments = segments_;
+    segments.clear();
     for (const LevelBorders::Segment& seg : borders_.segments) {
         if (asymmetric && seg.begin < lens.focus_distance && seg.end > lens.focus_distance) {
             segments.push_back({seg.begin, lens.focus_distance, seg.lo, seg.hi});
@@ -390,16 +409,21 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         return sides == 2 && seg.begin >= lens.focus_distance ? 1u : 0u;
     };
     // The bilinear taps of every level of T at the pixel centres (§6.1).
-    std::vector<std::vector<AxisTap>> tx(n + 1), ty(n + 1);
+    std::vector<std::vector<AxisTap>>& tx = tx_;
+    std::vector<std::vector<AxisTap>>& ty = ty_;
+    if (tx.size() < n + 1) {
+        tx.resize(n + 1);
+        ty.resize(n + 1);
+    }
     for (uint32_t s = 0; s <= n; ++s) {
         const FragmentLevel& l = *tlevel[1][s];
-        tx[s] = axisTaps(width, l.origin_x, l.spacing, l.width);
-        ty[s] = axisTaps(height, l.origin_y, l.spacing, l.height);
+        axisTaps(width, l.origin_x, l.spacing, l.width, tx[s]);
+        axisTaps(height, l.origin_y, l.spacing, l.height, ty[s]);
     }
     // What the traversal reads of a level: the cells its taps reach and the segments of T
     // that read it, merged where they touch.
-    const auto readsOf = [&](const FragmentLevel& level) {
-        LevelReads r;
+    const auto readsOf = [&](const FragmentLevel& level, LevelReads& r) {
+        r.depths.clear();
         readRange(tx[level.index], r.x0, r.x1);
         readRange(ty[level.index], r.y0, r.y1);
         for (const LevelBorders::Segment& seg : segments) {
@@ -411,7 +435,6 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             else
                 r.depths.push_back({seg.begin, seg.end});
         }
-        return r;
     };
 
     // §5: filter level by level.
@@ -422,9 +445,9 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         const size_t side = a / shaped_count; // 0: far, 1: near
         const auto grid = std::find_if(grids[side].begin(), grids[side].end(),
                                        [&](const ApertureGrid& g) { return g.size == l.grid; });
-        const LevelReads reads = readsOf(l);
+        readsOf(l, reads_);
         shapeLevel(levels_[l.source], *grid, plan.plan, borders_,
-                   settings.skip_unread_cells ? &reads : nullptr, pool, l);
+                   settings.skip_unread_cells ? &reads_ : nullptr, pool, l);
     }
     const double ms_filter = msSince(t0);
 
@@ -442,7 +465,19 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     // Slices join the group of the previous one while within this factor of its depth.
     const float group_scale =
         settings.blend == LayerBlend::Additive ? 1.0f + settings.additive_gap : 0.0f;
-    std::vector<uint64_t> row_slices(height, 0);
+    // Per segment of T: the last depth a slice may reach (below its end), and the levels it
+    // reads as a bit mask.
+    std::vector<float>& seg_last = seg_last_;
+    std::vector<uint64_t>& seg_levels = seg_levels_;
+    seg_last.resize(segments.size());
+    seg_levels.resize(segments.size());
+    for (size_t i = 0; i < segments.size(); ++i) {
+        seg_last[i] = std::nextafter(segments[i].end, 0.0f);
+        seg_levels[i] = (uint64_t{1} << segments[i].lo) | (uint64_t{1} << segments[i].hi);
+    }
+    static_assert(kMaxTraversalLevels <= 64);
+    std::vector<uint64_t>& row_slices = row_slices_;
+    row_slices.assign(height, 0);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {
         // The rows of cells every level's bilinear taps read on this row of pixels: those with
         // a weight > 0 that hold fragments (the others add w·0 to no slice).
@@ -457,24 +492,31 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             const size_t p = size_t(y) * width + x;
             // Bilinear taps of every level at the pixel centre, in the order (i0, j0), (i1, j0),
             // (i0, j1), (i1, j1); taps with weight 0 or an empty list are left out, since they
-            // add w·0 to every slice.
+            // add w·0 to every slice. `present` marks the levels with a tap left, per side.
+            uint64_t present[2] = {0, 0};
             for (uint32_t side = 0; side < sides; ++side)
                 for (uint32_t s = 0; s <= n; ++s) {
                     const TapRows& tr = rows[side][s];
+                    if (tr.count == 0) {
+                        cursor_count[side][s] = 0;
+                        continue;
+                    }
                     const AxisTap ax = tx[s][x];
                     const uint32_t cx[2] = {ax.i0, ax.i1};
                     const float wx[2] = {1.0f - ax.f, ax.f};
+                    Cursor* cur = cursors[side][s];
                     uint32_t c = 0;
                     for (uint32_t r = 0; r < tr.count; ++r)
                         for (int k = 0; k < 2; ++k) {
                             const float w = wx[k] * tr.weight[r];
                             const uint32_t first = tr.starts[r][cx[k]];
-                            const uint32_t count = tr.starts[r][cx[k] + 1] - first;
-                            if (!(w > 0.0f) || count == 0)
+                            const uint32_t last = tr.starts[r][cx[k] + 1];
+                            if (!(w > 0.0f) || last == first)
                                 continue;
-                            cursors[side][s][c++] = {tr.data[r] + first, count, 0, w, tr.pieces};
+                            cur[c++] = {tr.data[r] + first, tr.data[r] + last, w};
                         }
                     cursor_count[side][s] = c;
+                    present[side] |= uint64_t(c != 0) << s;
                 }
             {
                 uint32_t count = 0;
@@ -485,49 +527,47 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
             float ca_g = 0.0f, ga = 0.0f, last_d = 0.0f;
             bool first = true;
-            for (const LevelBorders::Segment& seg : segments) {
+            for (size_t si = 0; si < segments.size(); ++si) {
                 if (ca >= kOpaque)
                     break;
+                const LevelBorders::Segment& seg = segments[si];
                 const uint32_t side = sideOf(seg);
+                if ((present[side] & seg_levels[si]) == 0)
+                    continue; // nothing to read in this segment
                 Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
                 const uint32_t* count_side = cursor_count[side];
                 const uint32_t lv[2] = {seg.lo, seg.hi};
                 const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
-                if (count_side[seg.lo] == 0 && count_side[seg.hi] == 0)
-                    continue; // nothing to read in this segment
-                // Skip what lies in front of the segment (not asked of this level there).
-                for (uint32_t c = 0; c < classes; ++c)
-                    for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
-                        Cursor& cur = cur_side[lv[c]][k];
-                        while (cur.next < cur.count && cur.data[cur.next].depth < seg.begin)
-                            ++cur.next;
-                    }
                 while (ca < kOpaque) {
-                    // The closest fragment in the segment over both levels' taps.
+                    // The closest fragment in the segment over both levels' taps, after
+                    // skipping what lies in front of the segment (not asked of this level
+                    // there; a no-op after the first slice, since cursors only advance).
                     float d0 = seg.end;
                     bool any = false;
                     for (uint32_t c = 0; c < classes; ++c)
                         for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
-                            const Cursor& cur = cur_side[lv[c]][k];
-                            if (cur.next < cur.count && cur.data[cur.next].depth < d0)
-                                d0 = cur.data[cur.next].depth, any = true;
+                            Cursor& cur = cur_side[lv[c]][k];
+                            while (cur.next != cur.end && cur.next->depth < seg.begin)
+                                ++cur.next;
+                            if (cur.next != cur.end && cur.next->depth < d0)
+                                d0 = cur.next->depth, any = true;
                         }
                     if (!any)
                         break;
                     // One slice: the §5.1 merge across taps and the two levels, weighted by
                     // the bilinear weights and the level interpolation t(d0).
-                    const float limit = std::min(d0 * scale, std::nextafter(seg.end, 0.0f));
+                    const float limit = std::min(d0 * scale, seg_last[si]);
                     const float t = levelBlend(borders_, lens, seg, d0);
                     float part[2][4] = {{0.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
                     for (uint32_t c = 0; c < classes; ++c) {
                         const float level_weight = classes == 1 ? 1.0f : (c == 0 ? 1.0f - t : t);
+                        const bool pieces = rows[side][lv[c]].pieces;
                         for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
                             Cursor& cur = cur_side[lv[c]][k];
                             float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
-                            for (; cur.next < cur.count && cur.data[cur.next].depth <= limit;
-                                 ++cur.next) {
-                                const LayerFragment& f = cur.data[cur.next];
-                                const float tr = shareInList(f, cur.pieces, pa);
+                            for (; cur.next != cur.end && cur.next->depth <= limit; ++cur.next) {
+                                const LayerFragment& f = *cur.next;
+                                const float tr = shareInList(f, pieces, pa);
                                 pr += tr * f.r, pg += tr * f.g, pb += tr * f.b, pa += tr * f.a;
                             }
                             const float w = level_weight * cur.weight;
@@ -583,7 +623,17 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
 
     if (stats) {
         MultilayerStats& st = *stats;
+        // Reset, keeping the per-level arrays' memory (a warm caller's stats do not allocate).
+        std::vector<MultilayerLevelStats> level_stats = std::move(st.levels);
+        std::vector<MultilayerLevelStats> aperture_stats = std::move(st.apertures);
+        std::vector<MultilayerTraversalStats> traversal_stats = std::move(st.traversal);
         st = MultilayerStats{};
+        st.levels = std::move(level_stats);
+        st.apertures = std::move(aperture_stats);
+        st.traversal = std::move(traversal_stats);
+        st.levels.clear();
+        st.apertures.clear();
+        st.traversal.clear();
         st.ms_collect = ms_base;
         st.ms_filter = ms_filter;
         st.ms_accumulate = ms_accumulate;

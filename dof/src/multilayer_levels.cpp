@@ -2,6 +2,8 @@
 #include <raster/check.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -37,19 +39,105 @@ void sumRows(const std::vector<uint32_t>& longest, const std::vector<uint64_t>& 
     }
 }
 
-// Fills every cell (i, j) of `out` for which `needed(i, j)` holds with the §5.1 merge of the
-// lists `sources(i, j, src)` writes into src (returning how many), one task per row of cells
-// and the cells of a row in order, so the bytes do not depend on the thread count; the other
-// cells are left empty. With plan.truncate, merged fragments that level `border_level` of T
-// and every level above it never ask for are dropped (truncatedAt).
-template <class Needed, class Sources>
+// mergeLists for the taps of one cell, all with the same `pieces` and no empty list: list k
+// runs from next[k] to end[k] with weight[k], k in list order, m <= 64. The live lists are a
+// bit mask instead of mergeLists' index array and the within-list share is specialised at
+// compile time; the windows, the lists visited, the operations and their order are
+// mergeLists', hence the same bytes.
+template <bool kPieces, class Keep>
+void mergeTaps(const LayerFragment** next, const LayerFragment* const* end, const float* weight,
+               uint32_t m, float scale, bool mean_depth, Keep&& keep,
+               std::vector<LayerFragment>& out, uint64_t& dropped) {
+    static_assert(kMaxMergeLists <= 64);
+    uint64_t live = m >= 64 ? ~uint64_t{0} : (uint64_t{1} << m) - 1;
+    while (live != 0) {
+        // Closest head over all lists, in list order (a value: ties do not matter).
+        float d0 = next[std::countr_zero(live)]->depth;
+        for (uint64_t bits = live & (live - 1); bits != 0; bits &= bits - 1)
+            d0 = std::min(d0, next[std::countr_zero(bits)]->depth);
+        const float limit = d0 * scale;
+        LayerFragment merged;
+        float depth_sum = 0.0f;
+        for (uint64_t bits = live; bits != 0; bits &= bits - 1) {
+            const int k = std::countr_zero(bits);
+            const LayerFragment* f = next[k];
+            if (!(f->depth <= limit))
+                continue;
+            // Within list k, front to back (§5.1, first case). A list of one fragment (the
+            // common case) takes its first step only, with pa = 0.
+            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
+            if (end[k] - f == 1) {
+                const float t = shareInList(*f, kPieces, 0.0f);
+                pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
+                pd += t * f->a * f->depth;
+                live &= ~(uint64_t{1} << k);
+            } else {
+                do {
+                    const float t = shareInList(*f, kPieces, pa);
+                    pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
+                    pd += t * f->a * f->depth;
+                    ++f;
+                } while (f != end[k] && f->depth <= limit);
+                next[k] = f;
+                if (f == end[k])
+                    live &= ~(uint64_t{1} << k);
+            }
+            // Additive blending across lists (§5.1, second case), weighted.
+            const float w = weight[k];
+            merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
+            depth_sum += w * pd;
+        }
+        if (!(merged.a > 0.0f))
+            continue;
+        merged.depth = mean_depth ? std::clamp(depth_sum / merged.a, d0, limit) : d0;
+        if (!keep(merged.depth)) {
+            ++dropped;
+            continue;
+        }
+        out.push_back(merged);
+    }
+}
+
+// The taps of one cell, in merge order, empty lists left out (they would add w·0 = +0 to sums
+// that start at +0 and so are never -0: the same bytes).
+struct CellTaps {
+    const LayerFragment* next[kMaxMergeLists];
+    const LayerFragment* end[kMaxMergeLists];
+    float weight[kMaxMergeLists];
+    uint32_t m = 0;
+
+    void add(const LayerFragment* f, uint32_t count, float w) {
+        next[m] = f, end[m] = f + count, weight[m] = w;
+        ++m;
+    }
+    // Appends the §5.1 merge of the taps (mergeTaps) and consumes them.
+    template <class Keep>
+    void merge(const LevelPlan& plan, bool pieces, Keep&& keep, std::vector<LayerFragment>& out,
+               uint64_t& dropped) {
+        const float scale = 1.0f + plan.epsilon;
+        if (pieces)
+            mergeTaps<true>(next, end, weight, m, scale, plan.mean_depth, keep, out, dropped);
+        else
+            mergeTaps<false>(next, end, weight, m, scale, plan.mean_depth, keep, out, dropped);
+    }
+};
+
+// Fills every cell (i, j) of `out` for which `needed(i, j)` holds with the §5.1 merge
+// `row_merge(j)(i, keep, out_row, dropped)` appends to the row, one task per row of cells and
+// the cells of a row in order, so the bytes do not depend on the thread count; the other cells
+// are left empty. With plan.truncate, merged fragments that level `border_level` of T and every
+// level above it never ask for are dropped (truncatedAt).
+template <class Needed, class RowMerge>
 void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t border_level,
-                raster::TaskPool& pool, FragmentLevel& out, Needed&& needed, Sources&& sources) {
+                raster::TaskPool& pool, FragmentLevel& out, Needed&& needed, RowMerge&& row_merge) {
     out.rows.resize(out.height);
     out.starts.assign(size_t(out.height) * (out.width + 1), 0);
-    std::vector<uint32_t> longest(out.height, 0);
-    std::vector<uint64_t> dropped(out.height, 0);
-    std::vector<uint64_t> skipped(out.height, 0);
+    std::vector<uint32_t>& longest = out.scratch.longest;
+    std::vector<uint64_t>& dropped = out.scratch.dropped;
+    std::vector<uint64_t>& skipped = out.scratch.skipped;
+    longest.assign(out.height, 0);
+    dropped.assign(out.height, 0);
+    skipped.assign(out.height, 0);
     pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
         std::vector<LayerFragment>& row = out.rows[j];
         row.clear();
@@ -57,7 +145,7 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
         auto keep = [&](float d) {
             return !plan.truncate || !truncatedAt(borders, border_level, d);
         };
-        ListRef src[kMaxMergeLists];
+        auto merge = row_merge(j);
         // Counted on the stack and stored once: neighbouring rows' counts share cache lines.
         uint32_t row_longest = 0;
         uint64_t row_dropped = 0;
@@ -68,8 +156,7 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
                 ++row_skipped;
                 continue;
             }
-            const uint32_t count = sources(i, j, src);
-            mergeLists(src, count, plan.epsilon, plan.mean_depth, keep, row, row_dropped);
+            merge(i, keep, row, row_dropped);
             row_longest = std::max(row_longest, uint32_t(row.size()) - starts[i]);
         }
         starts[out.width] = uint32_t(row.size());
@@ -81,11 +168,11 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
 }
 
 // mergeCells over every cell.
-template <class Sources>
+template <class RowMerge>
 void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t border_level,
-                raster::TaskPool& pool, FragmentLevel& out, Sources&& sources) {
+                raster::TaskPool& pool, FragmentLevel& out, RowMerge&& row_merge) {
     const auto every = [](uint32_t, uint32_t) { return true; };
-    mergeCells(plan, borders, border_level, pool, out, every, sources);
+    mergeCells(plan, borders, border_level, pool, out, every, row_merge);
 }
 
 void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_height) {
@@ -144,9 +231,19 @@ std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const Lev
 LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
                           double aperture_second_moment) {
     LevelBorders t;
+    levelBorders(lens, level_variance, aperture_second_moment, t);
+    return t;
+}
+
+void levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
+                  double aperture_second_moment, LevelBorders& t) {
     t.levels = level_variance.empty() ? 0 : uint32_t(level_variance.size() - 1);
     t.second_moment = aperture_second_moment;
     t.variance = level_variance;
+    t.radius.clear();
+    t.z_near.clear();
+    t.z_far.clear();
+    t.segments.clear();
     const double k = double(lens.aperture_radius) * double(lens.focal_length_px); // E f_px
     const double inv_f = 1.0 / double(lens.focus_distance);
     const float inf = std::numeric_limits<float>::infinity();
@@ -172,7 +269,7 @@ LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level
     };
     if (n == 0) {
         add(0.0f, inf, 0, 0);
-        return t;
+        return;
     }
     add(0.0f, t.z_near[n], n, n);
     for (uint32_t s = n - 1; s >= 1; --s)
@@ -181,7 +278,6 @@ LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level
     for (uint32_t s = 1; s < n; ++s)
         add(t.z_far[s], t.z_far[s + 1], s, s + 1);
     add(t.z_far[n], inf, n, n);
-    return t;
 }
 
 float levelBlend(const LevelBorders& borders, const ThinLens& lens,
@@ -204,7 +300,8 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
     out.height = lists.height;
     out.rows.resize(lists.height);
     out.starts.assign(size_t(lists.height) * (lists.width + 1), 0);
-    std::vector<uint32_t> longest(lists.height, 0);
+    std::vector<uint32_t>& longest = out.scratch.longest;
+    longest.assign(lists.height, 0);
     pool.parallelFor(lists.height, [&](uint32_t y, uint32_t) {
         std::vector<LayerFragment>& row = out.rows[y];
         row.clear();
@@ -226,7 +323,8 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
         starts[lists.width] = uint32_t(row.size());
         longest[y] = row_longest;
     });
-    const std::vector<uint64_t> none(lists.height, 0);
+    std::vector<uint64_t>& none = out.scratch.dropped;
+    none.assign(lists.height, 0);
     sumRows(longest, none, none, out);
 }
 
@@ -236,20 +334,25 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
     const int32_t delta = int32_t(next.dilation);
     const int32_t max_x = int32_t(prev.width) - 1;
     const int32_t max_y = int32_t(prev.height) - 1;
-    mergeCells(plan, borders, border_level, pool, next, [&](uint32_t i, uint32_t j, ListRef* src) {
-        // Source rows and columns: mip 2i, 2i+1; stack i-Δ, i (border cells clamped, Fig. 4).
-        const int32_t x0 = std::clamp(mip ? 2 * int32_t(i) : int32_t(i) - delta, 0, max_x);
-        const int32_t x1 = std::clamp(mip ? 2 * int32_t(i) + 1 : int32_t(i), 0, max_x);
-        const int32_t y0 = std::clamp(mip ? 2 * int32_t(j) : int32_t(j) - delta, 0, max_y);
-        const int32_t y1 = std::clamp(mip ? 2 * int32_t(j) + 1 : int32_t(j), 0, max_y);
-        const int32_t xs[4] = {x0, x1, x0, x1};
-        const int32_t ys[4] = {y0, y0, y1, y1};
-        for (int k = 0; k < 4; ++k) {
-            src[k].data = prev.list(uint32_t(xs[k]), uint32_t(ys[k]), src[k].count);
-            src[k].weight = 0.25f; // §5.1: α_merged = (α'_1 + ... + α'_4) / 4
-            src[k].pieces = prev.kind != LevelKind::Base;
-        }
-        return 4u;
+    const bool pieces = prev.kind != LevelKind::Base;
+    mergeCells(plan, borders, border_level, pool, next, [&](uint32_t j) {
+        return [&, j](uint32_t i, auto& keep, std::vector<LayerFragment>& row, uint64_t& dropped) {
+            // Source rows and columns: mip 2i, 2i+1; stack i-Δ, i (border cells clamped, Fig. 4).
+            const int32_t x0 = std::clamp(mip ? 2 * int32_t(i) : int32_t(i) - delta, 0, max_x);
+            const int32_t x1 = std::clamp(mip ? 2 * int32_t(i) + 1 : int32_t(i), 0, max_x);
+            const int32_t y0 = std::clamp(mip ? 2 * int32_t(j) : int32_t(j) - delta, 0, max_y);
+            const int32_t y1 = std::clamp(mip ? 2 * int32_t(j) + 1 : int32_t(j), 0, max_y);
+            const int32_t xs[4] = {x0, x1, x0, x1};
+            const int32_t ys[4] = {y0, y0, y1, y1};
+            CellTaps taps;
+            for (int k = 0; k < 4; ++k) {
+                uint32_t count = 0;
+                const LayerFragment* f = prev.list(uint32_t(xs[k]), uint32_t(ys[k]), count);
+                if (count > 0)
+                    taps.add(f, count, 0.25f); // §5.1: α_merged = (α'_1 + ... + α'_4) / 4
+            }
+            taps.merge(plan, pieces, keep, row, dropped);
+        };
     });
 }
 
@@ -301,73 +404,136 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
     // flagged, then the flags are widened by the taps' reach, along x on every box row
     // (near_x) and along y per cell (the G x G square: a superset of the taps with weight).
     const float scale = 1.0f + plan.epsilon;
-    std::vector<uint8_t> flag(reads ? size_t(box.width) * box.height : 0);
-    std::vector<uint8_t> near_x(reads ? size_t(box.height) * out.width : 0);
+    std::vector<uint8_t>& flag = out.scratch.flag;
+    std::vector<uint8_t>& near_x = out.scratch.near_x;
+    flag.resize(reads ? size_t(box.width) * box.height : 0);
+    near_x.resize(reads ? size_t(box.height) * out.width : 0);
+    // (Sizes and pointers are copied into locals: the byte stores below may alias them.)
+    const uint32_t box_width = box.width;
+    const uint32_t out_width = out.width;
+    const LevelReads::Depths* depths = reads ? reads->depths.data() : nullptr;
+    const uint32_t depth_count = reads ? uint32_t(reads->depths.size()) : 0;
     pool.parallelFor(reads ? box.height : 0, [&](uint32_t y, uint32_t) {
-        uint8_t* f = flag.data() + size_t(y) * box.width;
-        for (uint32_t x = 0; x < box.width; ++x) {
-            uint32_t count = 0;
-            const LayerFragment* l = box.list(x, y, count);
+        uint8_t* f = flag.data() + size_t(y) * box_width;
+        const uint32_t* st = box.starts.data() + size_t(y) * (box_width + 1);
+        const LayerFragment* data = box.rows[y].data();
+        for (uint32_t x = 0; x < box_width; ++x) {
             bool hit = false;
-            for (uint32_t k = 0; k < count && !hit; ++k)
-                for (const LevelReads::Depths& r : reads->depths)
-                    hit = hit || (l[k].depth < r.end && l[k].depth * scale >= r.begin);
+            for (uint32_t k = st[x]; k < st[x + 1] && !hit; ++k) {
+                const float d = data[k].depth;
+                for (uint32_t r = 0; r < depth_count; ++r)
+                    hit = hit || (d < depths[r].end && d * scale >= depths[r].begin);
+            }
             f[x] = hit ? 1 : 0;
         }
     });
     pool.parallelFor(reads ? box.height : 0, [&](uint32_t y, uint32_t) {
-        const uint8_t* f = flag.data() + size_t(y) * box.width;
-        uint8_t* o = near_x.data() + size_t(y) * out.width;
-        for (uint32_t i = 0; i < out.width; ++i) {
+        const uint8_t* f = flag.data() + size_t(y) * box_width;
+        uint8_t* o = near_x.data() + size_t(y) * out_width;
+        // Inside, no column is clamped: the OR of the shifted flag rows (vectorised); at the
+        // borders, clamped columns.
+        const int32_t lo = std::min(reach, int32_t(out_width));
+        const int32_t hi = std::max(lo, max_x + 1); // [lo, hi) inside
+        for (int32_t i = lo; i < hi; ++i)
+            o[i] = 0;
+        for (int32_t a = 0; a <= reach; a += step) {
+            const uint8_t* src = f + a - reach;
+            for (int32_t i = lo; i < hi; ++i)
+                o[i] |= src[i];
+        }
+        for (int32_t i = 0; i < int32_t(out_width); ++i) {
+            if (i == lo)
+                i = hi;
+            if (i >= int32_t(out_width))
+                break;
             uint8_t any = 0;
             for (int32_t a = 0; a <= reach; a += step)
-                any |= f[std::clamp(int32_t(i) + a - reach, 0, max_x)];
+                any |= f[std::clamp(i + a - reach, 0, max_x)];
             o[i] = any;
         }
     });
-    const auto needed = [&](uint32_t i, uint32_t j) {
-        if (!reads)
-            return true;
-        if (i < reads->x0 || i > reads->x1 || j < reads->y0 || j > reads->y1)
-            return false;
-        for (int32_t b = 0; b <= reach; b += step)
-            if (near_x[size_t(std::clamp(int32_t(j) + b - reach, 0, max_y)) * out.width + i])
-                return true;
-        return false;
+    // The cells to merge: inside the reads' window, with a flag within the taps' reach along
+    // y (the OR of near_x's rows, vectorised), one byte per cell.
+    std::vector<uint8_t>& need = out.scratch.need;
+    need.resize(reads ? size_t(out.height) * out_width : 0);
+    pool.parallelFor(reads ? out.height : 0, [&](uint32_t j, uint32_t) {
+        uint8_t* o = need.data() + size_t(j) * out_width;
+        std::fill(o, o + out_width, uint8_t{0});
+        if (j < reads->y0 || j > reads->y1 || reads->x0 > reads->x1)
+            return;
+        const uint32_t x0 = reads->x0;
+        const uint32_t x1 = std::min(reads->x1, out_width - 1);
+        for (int32_t b = 0; b <= reach; b += step) {
+            const uint8_t* src =
+                near_x.data() + size_t(std::clamp(int32_t(j) + b - reach, 0, max_y)) * out_width;
+            for (uint32_t i = x0; i <= x1; ++i)
+                o[i] |= src[i];
+        }
+    });
+    const uint8_t* need_map = need.data();
+    const auto needed = [need_map, out_width, all = !reads](uint32_t i, uint32_t j) {
+        return all || need_map[size_t(j) * out_width + i] != 0;
     };
     // Every box row's list starts and fragments, looked up once instead of per tap.
-    std::vector<const uint32_t*> row_starts(box.height);
-    std::vector<const LayerFragment*> row_data(box.height);
+    std::vector<const uint32_t*>& row_starts = out.scratch.row_starts;
+    std::vector<const LayerFragment*>& row_data = out.scratch.row_data;
+    row_starts.resize(box.height);
+    row_data.resize(box.height);
     for (uint32_t y = 0; y < box.height; ++y) {
         row_starts[y] = box.starts.data() + size_t(y) * (box.width + 1);
         row_data[y] = box.rows[y].data();
     }
     const bool pieces = box.kind != LevelKind::Base;
-    mergeCells(
-        plan, borders, out.index, pool, out, needed, [&](uint32_t i, uint32_t j, ListRef* src) {
-            // The taps with weight in grid order (a fixed merge order). Empty taps add
-            // nothing to the merge (x + w·0 = x), so only the others are passed: the
-            // same bytes, less work where the view shows background.
-            uint32_t used = 0;
-            // Border cells clamped, as the stack's (Fig. 4); inside, no column is.
+    // The taps with weight, in grid order: box cell offsets from the cell (before clamping).
+    struct Tap {
+        int32_t dx = 0;
+        uint32_t row = 0; // b
+        float w = 0.0f;
+    };
+    Tap taps[kMaxMergeLists];
+    uint32_t tap_count = 0;
+    for (uint32_t b = 0; b < grid.size; ++b)
+        for (uint32_t a = 0; a < grid.size; ++a)
+            if (grid.at(a, b) > 0.0f)
+                taps[tap_count++] = {int32_t(a) * step - reach, b, grid.at(a, b)};
+    const uint32_t box_cells = box.width;
+    mergeCells(plan, borders, out.index, pool, out, needed, [&](uint32_t j) {
+        // The taps on this row of cells that read a box row with fragments (border rows
+        // clamped, as the stack's, Fig. 4), in grid order: that row's list starts and
+        // fragments, the column offset and the weight.
+        struct RowTap {
+            const uint32_t* starts = nullptr;
+            const LayerFragment* data = nullptr;
+            int32_t dx = 0;
+            float w = 0.0f;
+        };
+        std::array<RowTap, kMaxMergeLists> row_taps;
+        uint32_t row_tap_count = 0;
+        for (uint32_t k = 0; k < tap_count; ++k) {
+            const Tap& tap = taps[k];
+            const int32_t y = std::clamp(int32_t(j) + int32_t(tap.row) * step - reach, 0, max_y);
+            const uint32_t* st = row_starts[size_t(y)];
+            if (st[0] != st[box_cells])
+                row_taps[row_tap_count++] = {st, row_data[size_t(y)], tap.dx, tap.w};
+        }
+        return [&, row_taps, row_tap_count](uint32_t i, auto& keep, std::vector<LayerFragment>& row,
+                                            uint64_t& dropped) {
+            // The taps with weight in grid order (a fixed merge order); empty lists are left
+            // out (CellTaps). Border cells clamped, as the stack's (Fig. 4); inside, no column
+            // is.
             const bool inside = int32_t(i) >= reach && int32_t(i) <= max_x;
-            for (uint32_t b = 0; b < grid.size; ++b) {
-                const int32_t y = std::clamp(int32_t(j) + int32_t(b) * step - reach, 0, max_y);
-                const uint32_t* st = row_starts[size_t(y)];
-                if (st[0] == st[box.width])
-                    continue; // an empty row
-                for (uint32_t a = 0; a < grid.size; ++a) {
-                    const float w = grid.at(a, b);
-                    const int32_t xt = int32_t(i) + int32_t(a) * step - reach;
-                    const uint32_t x = uint32_t(inside ? xt : std::clamp(xt, 0, max_x));
-                    const uint32_t count = st[x + 1] - st[x];
-                    if (!(w > 0.0f) || count == 0)
-                        continue;
-                    src[used++] = {row_data[size_t(y)] + st[x], count, w, pieces};
-                }
+            CellTaps cell;
+            for (uint32_t k = 0; k < row_tap_count; ++k) {
+                const RowTap& tap = row_taps[k];
+                const int32_t xt = int32_t(i) + tap.dx;
+                const uint32_t x = uint32_t(inside ? xt : std::clamp(xt, 0, max_x));
+                const uint32_t count = tap.starts[x + 1] - tap.starts[x];
+                if (count > 0)
+                    cell.add(tap.data + tap.starts[x], count, tap.w);
             }
-            return used;
-        });
+            cell.merge(plan, pieces, keep, row, dropped);
+        };
+    });
 }
 
 } // namespace dof

@@ -79,6 +79,21 @@ struct FragmentLevel {
     uint64_t truncated = 0; // merged fragments dropped by the §6.2 rule
     uint64_t skipped = 0;   // cells left empty, never read by the traversal (LevelReads)
 
+    // Working memory of the stage that fills the level (per-row counts, shapeLevel's read
+    // flags), kept with it between frames so that a warm level allocates nothing. Not part of
+    // the level's content.
+    struct Scratch {
+        std::vector<uint32_t> longest;
+        std::vector<uint64_t> dropped;
+        std::vector<uint64_t> skipped;
+        std::vector<uint8_t> flag;
+        std::vector<uint8_t> near_x;
+        std::vector<uint8_t> need;
+        std::vector<const uint32_t*> row_starts;
+        std::vector<const LayerFragment*> row_data;
+    };
+    Scratch scratch;
+
     double variance() const { return filter_variance + lookup_variance; }
     const LayerFragment* list(uint32_t i, uint32_t j, uint32_t& count) const {
         const size_t s = size_t(j) * (width + 1) + i;
@@ -143,6 +158,9 @@ struct LevelBorders {
 // Builds T for the levels' variances and the lens.
 LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
                           double aperture_second_moment);
+// The same into `out`, reusing its memory.
+void levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,
+                  double aperture_second_moment, LevelBorders& out);
 
 // Interpolation weight of level hi at depth d in `segment` (0 when lo == hi).
 float levelBlend(const LevelBorders& borders, const ThinLens& lens,

@@ -186,11 +186,35 @@ public:
     const std::vector<FragmentLevel>& apertureLevels() const { return apertures_; }
     const LevelBorders& borders() const { return borders_; }
 
+    // The bilinear taps of a level along one axis at a pixel centre: cells i0, i1 and the
+    // weight f of i1 (an implementation detail, public for the scratch below).
+    struct AxisTap {
+        uint32_t i0 = 0;
+        uint32_t i1 = 0;
+        float f = 0.0f;
+    };
+
 private:
     raster::FragmentLists lists_;
     std::vector<FragmentLevel> levels_;
     std::vector<FragmentLevel> apertures_;
     LevelBorders borders_;
+    // The aperture grids [far, near] of the last frame and what they were made from: they are
+    // a pure function of the shape and the grid sizes, so a frame with the same ones reuses
+    // them.
+    std::vector<ApertureGrid> grids_[2];
+    ApertureShape grid_shape_;
+    std::vector<uint32_t> grid_sizes_;
+    double grid_m2_ = 0.0;
+    bool grid_asymmetric_ = false;
+    // Working memory kept between frames, so that a warm Multilayer allocates less.
+    std::vector<float> row_min_, row_max_;
+    std::vector<std::vector<AxisTap>> tx_, ty_;
+    std::vector<LevelBorders::Segment> segments_;
+    std::vector<float> seg_last_;
+    std::vector<uint64_t> seg_levels_;
+    std::vector<uint64_t> row_slices_;
+    LevelReads reads_;
 };
 
 } // namespace dof
