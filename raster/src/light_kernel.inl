@@ -68,9 +68,11 @@ inline float powUnit(float x, float s) {
 
 } // namespace
 
-void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* lights, uint32_t light_count,
-                             const LightMaterial& material, const float eye[3], LightLanes& io,
-                             int lanes) {
+// __restrict: io never overlaps the lights, the material or the eye, which lets the lane loops
+// keep the light constants in registers.
+void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* __restrict lights, uint32_t light_count,
+                             const LightMaterial& __restrict material, const float* __restrict eye,
+                             LightLanes& __restrict io, int lanes) {
     const int n_lanes = FOCAL_LIGHT_KERNEL_FULL_WIDTH ? kLightLanes : lanes;
     const float metallic = material.metallic < 0.0f   ? 0.0f
                            : material.metallic > 1.0f ? 1.0f
