@@ -5,13 +5,14 @@
 // not part of the library, the CLI or the tests (docs/benchmarks.md, "Rasterizer throughput").
 //
 // The workload mirrors raster/src/shading.cpp and tile_raster.cpp: the same triangles, view and
-// projection (z/w = D in [0,1] via glClipControl), per-pixel Lambert + energy-normalised
-// Blinn-Phong over the scene's punctual lights (or focal's default light), ambient 0.12 x albedo,
-// emissive, base colour and emissive textures as sRGB with focal's own mip chains (trilinear per
-// the glTF sampler), vertex colours, alpha test for MASK, "over" blending without depth writes for
-// BLEND, back-face culling unless double-sided, and a float32 depth buffer. Each timed frame is
-// clear + every draw + glFinish. Thread count: LP_NUM_THREADS (set by --threads before the
-// context exists; 0 = llvmpipe runs the rasterizer inline on the calling thread).
+// projection (z/w = D + 1 in [0,1] via glClipControl; focal stores D in [-1, 0]), per-pixel Lambert
+// + energy-normalised Blinn-Phong over the scene's punctual lights (or focal's default light),
+// ambient 0.12 x albedo, emissive, base colour and emissive textures as sRGB with focal's own mip
+// chains (trilinear per the glTF sampler), vertex colours, alpha test for MASK, "over" blending
+// without depth writes for BLEND, back-face culling unless double-sided, and a float32 depth
+// buffer. Each timed frame is clear + every draw + glFinish. Thread count: LP_NUM_THREADS (set by
+// --threads before the context exists; 0 = llvmpipe runs the rasterizer inline on the calling
+// thread).
 
 #define GL_GLEXT_PROTOTYPES 1
 #include "apps/image_io.h"
@@ -514,7 +515,13 @@ int main(int argc, char** argv) {
     } else {
         view = raster::viewFramingBounds(raster::worldBounds(scene), opt.width, opt.height);
     }
-    const glm::mat4 view_proj = raster::projectionMatrix(view) * raster::viewMatrix(view);
+    // focal's clip space has z/w = D in [-1, 0] (reversed-Z with the sign flipped, camera.h);
+    // GL's zero-to-one clip volume needs [0, 1], so z' = z + w gives z'/w = D + 1: the same near
+    // and far clip planes and the same depth order (LESS, cleared to 1 = the far plane).
+    glm::mat4 depth_shift(1.0f);
+    depth_shift[3][2] = 1.0f; // column w, row z
+    const glm::mat4 view_proj =
+        depth_shift * raster::projectionMatrix(view) * raster::viewMatrix(view);
     const glm::vec3 eye = view.eye;
 
     // Context: OSMesa with a core profile; rendering goes to an FBO, so the OSMesa buffer only
@@ -545,7 +552,7 @@ int main(int argc, char** argv) {
     if (!renderer || !std::strstr(renderer, "llvmpipe"))
         return fail("OSMesa is not running on llvmpipe");
 
-    // D3D-style depth: clip z/w in [0,1], as focal's projectionMatrix produces (camera.h).
+    // D3D-style depth: clip z/w in [0,1] (focal's D + 1, see view_proj above).
     auto clip_control = reinterpret_cast<PFNGLCLIPCONTROLPROC>(
         reinterpret_cast<void*>(OSMesaGetProcAddress("glClipControl")));
     if (!clip_control)

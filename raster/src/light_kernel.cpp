@@ -10,7 +10,9 @@
 namespace raster {
 
 #define FOCAL_LIGHT_KERNEL_NAME lightKernelScalar
+#define FOCAL_LIGHT_KERNEL_FULL_WIDTH 0
 #include "light_kernel.inl"
+#undef FOCAL_LIGHT_KERNEL_FULL_WIDTH
 #undef FOCAL_LIGHT_KERNEL_NAME
 
 #ifdef FOCAL_NO_SIMD

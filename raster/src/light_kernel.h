@@ -49,6 +49,9 @@ struct LightLanes {
     float rgb[3][kLightLanes];    // output
 };
 
+// Shades lanes [0, lanes) of `io`. The SIMD build computes all kLightLanes lanes in one vector
+// pass (the lanes are independent, so the bits of [0, lanes) are the same): every lane of io's
+// inputs must be initialised, and the rgb of lanes past `lanes` is overwritten with any value.
 using LightKernel = void (*)(const PreparedLight* lights, uint32_t light_count,
                              const LightMaterial& material, const float eye[3], LightLanes& io,
                              int lanes);

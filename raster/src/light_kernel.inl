@@ -3,6 +3,11 @@
 #ifndef FOCAL_LIGHT_KERNEL_NAME
 #error "define FOCAL_LIGHT_KERNEL_NAME before including light_kernel.inl"
 #endif
+// 1: compute every one of the kLightLanes lanes whatever `lanes` says (the SIMD build: one
+// vector pass instead of a scalar loop over a partial vector); 0: only lanes [0, lanes).
+#ifndef FOCAL_LIGHT_KERNEL_FULL_WIDTH
+#error "define FOCAL_LIGHT_KERNEL_FULL_WIDTH before including light_kernel.inl"
+#endif
 
 namespace {
 
@@ -63,9 +68,12 @@ inline float powUnit(float x, float s) {
 
 } // namespace
 
-void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* lights, uint32_t light_count,
-                             const LightMaterial& material, const float eye[3], LightLanes& io,
-                             int lanes) {
+// __restrict: io never overlaps the lights, the material or the eye, which lets the lane loops
+// keep the light constants in registers.
+void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* __restrict lights, uint32_t light_count,
+                             const LightMaterial& __restrict material, const float* __restrict eye,
+                             LightLanes& __restrict io, int lanes) {
+    const int n_lanes = FOCAL_LIGHT_KERNEL_FULL_WIDTH ? kLightLanes : lanes;
     const float metallic = material.metallic < 0.0f   ? 0.0f
                            : material.metallic > 1.0f ? 1.0f
                                                       : material.metallic;
@@ -78,7 +86,7 @@ void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* lights, uint32_t light_count,
 
     alignas(32) float n[3][kLightLanes], v[3][kLightLanes], diffuse[3][kLightLanes],
         f0[3][kLightLanes];
-    for (int l = 0; l < lanes; ++l) {
+    for (int l = 0; l < n_lanes; ++l) {
         const float nx = io.normal[0][l], ny = io.normal[1][l], nz = io.normal[2][l];
         const float len2 = nx * nx + ny * ny + nz * nz;
         const float inv_len = len2 > 0.0f ? 1.0f / __builtin_sqrtf(len2) : 0.0f;
@@ -120,12 +128,12 @@ void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* lights, uint32_t light_count,
     for (uint32_t li = 0; li < light_count; ++li) {
         const PreparedLight& L = lights[li];
         if (L.type == Light::Type::Directional) {
-            for (int l = 0; l < lanes; ++l)
+            for (int l = 0; l < n_lanes; ++l)
                 accumulate(L, l, -L.direction[0], -L.direction[1], -L.direction[2], 1.0f);
             continue;
         }
         // Point and spot lights (a point light's cone constants make the cone factor 1).
-        for (int l = 0; l < lanes; ++l) {
+        for (int l = 0; l < n_lanes; ++l) {
             const float tx = L.position[0] - io.world[0][l], ty = L.position[1] - io.world[1][l],
                         tz = L.position[2] - io.world[2][l];
             const float d2raw = tx * tx + ty * ty + tz * tz;

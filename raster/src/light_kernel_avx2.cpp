@@ -10,7 +10,9 @@ namespace raster {
 
 namespace {
 #define FOCAL_LIGHT_KERNEL_NAME lightKernelAvx2Impl
+#define FOCAL_LIGHT_KERNEL_FULL_WIDTH 1
 #include "light_kernel.inl"
+#undef FOCAL_LIGHT_KERNEL_FULL_WIDTH
 #undef FOCAL_LIGHT_KERNEL_NAME
 } // namespace
 

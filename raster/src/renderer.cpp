@@ -127,6 +127,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.mode = options.shading;
     st.ctx.shade.filter = options.texture_filter;
     st.ctx.kernel = selectQuadKernel(options.simd);
+    st.ctx.fragment_kernel = selectFragmentKernel(options.simd);
     st.ctx.blend_last = hasBlendMaterial(scene);
     prepareLights(scene, defaultLightDirection(view), st.lights);
     st.ctx.shade.lights = st.lights.data();

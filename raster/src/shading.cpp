@@ -121,7 +121,7 @@ GSample surfaceSample(const ShadeContext& ctx, const Material& m, glm::vec3 base
 glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world, glm::vec3 eye) {
     if (g.unlit != 0.0f)
         return g.base_color + g.emissive;
-    LightLanes lanes;
+    LightLanes lanes{}; // every lane initialised (light_kernel.h)
     for (int c = 0; c < 3; ++c) {
         lanes.albedo[c][0] = g.base_color[c];
         lanes.emissive[c][0] = g.emissive[c];

@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace raster {
@@ -27,10 +28,42 @@ struct TriangleRaster {
     const Material* material;
     Edge edges[3];
     double inv_area2;
-    glm::vec3 face_normal; // faces the eye; used when the primitive has no normals
-    bool has_normals;
-    bool has_colors; // without vertex colours the colour is exactly white
+    const Primitive* prim;
+    // The vertex attributes and material constants the lanes share, filled when the first
+    // lanes of the triangle pass the depth test (many small triangles never get there).
+    bool frag_ready;
+    FragmentTriangle frag;
 };
+
+void fillFragmentTriangle(const ShadeContext& shade, TriangleRaster& tr) {
+    const SetupTri& t = *tr.tri;
+    glm::vec3 face_normal =
+        glm::cross(tr.v[1]->world - tr.v[0]->world, tr.v[2]->world - tr.v[0]->world);
+    if (glm::dot(face_normal, shade.eye - tr.v[0]->world) < 0.0f)
+        face_normal = -face_normal;
+    FragmentTriangle& f = tr.frag;
+    const Material& m = *tr.material;
+    f.has_colors = !tr.prim->colors.empty();
+    f.has_normals = !tr.prim->normals.empty();
+    f.flip_normal = !t.front_facing;
+    f.mask = m.alpha_mode == AlphaMode::Mask;
+    f.blend = m.alpha_mode == AlphaMode::Blend;
+    f.alpha_cutoff = m.alpha_cutoff;
+    for (int c = 0; c < 4; ++c) {
+        f.base_factor[c] = m.base_color_factor[c];
+        for (int k = 0; k < 3; ++k)
+            f.color[c][k] = tr.v[k]->color[c];
+    }
+    for (int c = 0; c < 3; ++c) {
+        f.face_normal[c] = face_normal[c];
+        f.emissive_factor[c] = m.emissive_factor[c];
+        for (int k = 0; k < 3; ++k) {
+            f.world[c][k] = tr.v[k]->world[c];
+            f.normal[c][k] = tr.v[k]->normal[c];
+        }
+    }
+    tr.frag_ready = true;
+}
 
 glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
     return q.persp[0][l] * tr.v[0]->uv + q.persp[1][l] * tr.v[1]->uv + q.persp[2][l] * tr.v[2]->uv;
@@ -40,8 +73,8 @@ glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
 // coverage, barycentrics and depth for the 8 pixels at once; the covered ones are then shaded and
 // handed to the sink one by one, in lane order.
 template <class Sink>
-void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t qx, int32_t qy,
-                   Sink& sink, TileCounters& counters) {
+void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int32_t qy, Sink& sink,
+                   TileCounters& counters) {
     const SetupTri& t = *tr.tri;
     QuadInput in;
     for (int k = 0; k < 3; ++k) {
@@ -104,84 +137,50 @@ void shadeQuadPair(const RasterContext& ctx, const TriangleRaster& tr, int32_t q
     const bool base_textured = m.base_color_texture.image >= 0;
     const bool emissive_textured =
         m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
-    float base_texel[4][kTextureLanes], emissive_texel[4][kTextureLanes];
+    // Zero-initialised: the fragment kernel reads every lane (fragment_kernel.h).
+    alignas(32) float base_texel[4][kTextureLanes] = {}, emissive_texel[4][kTextureLanes] = {};
     if (base_textured)
         sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, tested, base_texel);
     if (emissive_textured)
         sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, tested, emissive_texel);
 
-    // Per lane that passed: base colour (factor x vertex colour x texture), alpha test.
-    const bool blend = m.alpha_mode == AlphaMode::Blend;
-    float alpha[kQuadLanes];
-    int lane_of[kQuadLanes];
-    glm::vec3 normals[kQuadLanes];
-    int active = 0;
+    // Every lane's attributes, base colour and alpha test (the fragment kernel), then the
+    // lanes that pass are shaded together (the lighting kernel) and handed to the sink.
+    if (!tr.frag_ready)
+        fillFragmentTriangle(ctx.shade, tr);
     LightLanes light;
-    for (int l = 0; l < kQuadLanes; ++l) {
-        if (!(tested & (1u << l)))
-            continue;
-        const float b[3] = {q.persp[0][l], q.persp[1][l], q.persp[2][l]};
-        const glm::vec4 vcolor =
-            tr.has_colors ? b[0] * tr.v[0]->color + b[1] * tr.v[1]->color + b[2] * tr.v[2]->color
-                          : glm::vec4(1.0f);
-        glm::vec4 base = m.base_color_factor * vcolor;
-        if (base_textured)
-            base *=
-                glm::vec4(base_texel[0][l], base_texel[1][l], base_texel[2][l], base_texel[3][l]);
-        if (m.alpha_mode == AlphaMode::Mask && !(base.a >= m.alpha_cutoff))
-            continue;
-        // A BLEND fragment of opacity 0 changes nothing: dropped like a masked one, so it takes
-        // no fragment-list slot and no transparent depth.
-        if (blend && !(base.a > 0.0f))
-            continue;
-        ++counters.passed;
-        const glm::vec3 world =
-            b[0] * tr.v[0]->world + b[1] * tr.v[1]->world + b[2] * tr.v[2]->world;
-        glm::vec3 normal = tr.face_normal;
-        if (tr.has_normals) {
-            normal = b[0] * tr.v[0]->normal + b[1] * tr.v[1]->normal + b[2] * tr.v[2]->normal;
-            if (!t.front_facing)
-                normal = -normal; // glTF: back faces of double-sided materials flip the normal
-        }
-        glm::vec3 emissive = m.emissive_factor;
-        if (emissive_textured)
-            emissive *= glm::vec3(emissive_texel[0][l], emissive_texel[1][l], emissive_texel[2][l]);
-        for (int c = 0; c < 3; ++c) {
-            light.albedo[c][active] = base[c];
-            light.emissive[c][active] = emissive[c];
-            light.world[c][active] = world[c];
-            light.normal[c][active] = normal[c];
-        }
-        alpha[active] = blend ? std::clamp(base.a, 0.0f, 1.0f) : 1.0f;
-        normals[active] = normal;
-        lane_of[active++] = l;
-    }
-    if (active == 0)
+    alignas(32) float alpha[kQuadLanes];
+    const uint32_t passed =
+        ctx.fragment_kernel(tr.frag, q.persp, base_textured ? base_texel : nullptr,
+                            emissive_textured ? emissive_texel : nullptr, tested, light, alpha);
+    if (passed == 0)
         return;
-
-    // Shade the surviving lanes together (the lighting kernel), then hand them to the sink.
+    counters.passed += uint64_t(std::popcount(passed));
     const bool unlit = isUnlit(ctx.shade, m);
     if (!unlit) {
         const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
         ctx.shade.light_kernel(ctx.shade.lights, ctx.shade.light_count,
-                               {m.metallic_factor, m.roughness_factor}, eye, light, active);
+                               {m.metallic_factor, m.roughness_factor}, eye, light,
+                               int(std::bit_width(passed)));
     }
-    for (int i = 0; i < active; ++i) {
-        const int l = lane_of[i];
+    const bool blend = m.alpha_mode == AlphaMode::Blend;
+    for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
+        const int l = std::countr_zero(rest);
         const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
         Fragment frag;
         frag.z = q.z[l];
         frag.distance = q.distance[l];
         frag.blend = blend;
-        frag.color.a = alpha[i];
+        frag.color.a = alpha[l];
         frag.primitive_id = t.primitive_id;
         for (int c = 0; c < 3; ++c)
-            frag.color[c] = unlit ? light.albedo[c][i] + light.emissive[c][i] : light.rgb[c][i];
+            frag.color[c] = unlit ? light.albedo[c][l] + light.emissive[c][l] : light.rgb[c][l];
         if (sink.wants_gbuffer) {
-            const glm::vec3 base(light.albedo[0][i], light.albedo[1][i], light.albedo[2][i]);
-            const glm::vec3 emissive(light.emissive[0][i], light.emissive[1][i],
-                                     light.emissive[2][i]);
-            frag.g = surfaceSample(ctx.shade, m, base, emissive, normals[i]);
+            const glm::vec3 base(light.albedo[0][l], light.albedo[1][l], light.albedo[2][l]);
+            const glm::vec3 emissive(light.emissive[0][l], light.emissive[1][l],
+                                     light.emissive[2][l]);
+            const glm::vec3 normal(light.normal[0][l], light.normal[1][l], light.normal[2][l]);
+            frag.g = surfaceSample(ctx.shade, m, base, emissive, normal);
         }
         sink.write(size_t(y) * ctx.grid.width + size_t(x), frag);
     }
@@ -201,11 +200,8 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     tr.material = &materialOf(*ctx.shade.scene, prim);
     makeEdges(t, tr.edges);
     tr.inv_area2 = 1.0 / double(t.area2);
-    tr.has_normals = !prim.normals.empty();
-    tr.has_colors = !prim.colors.empty();
-    tr.face_normal = glm::cross(tr.v[1]->world - tr.v[0]->world, tr.v[2]->world - tr.v[0]->world);
-    if (glm::dot(tr.face_normal, ctx.shade.eye - tr.v[0]->world) < 0.0f)
-        tr.face_normal = -tr.face_normal;
+    tr.prim = &prim;
+    tr.frag_ready = false;
     sink.beginTriangle(t, tr.material->alpha_mode == AlphaMode::Blend);
 
     // Pixel range of this triangle in this tile, widened to whole quad pairs.

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "binning.h"
+#include "fragment_kernel.h"
 #include "geometry.h"
 #include "quad_kernel.h"
 #include "shading.h"
@@ -23,6 +24,7 @@ struct RasterContext {
     TileGrid grid;
     ShadeContext shade;
     QuadKernel kernel = &quadKernelScalar;
+    FragmentKernel fragment_kernel = &fragmentKernelScalar;
     bool blend_last = false; // the scene has BLEND materials: draw their triangles last
 };
 

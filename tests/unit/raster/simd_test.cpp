@@ -1,5 +1,5 @@
 // The SIMD kernels give the same bits as the scalar references (issue 3, SIMD; issue 19, the
-// texture kernel).
+// texture and fragment kernels).
 #include "support/test_util.h"
 
 #include <raster/task_pool.h>
@@ -12,6 +12,7 @@
 #include <cstring>
 
 // The kernels are internal to raster.
+#include "raster/src/fragment_kernel.h"
 #include "raster/src/light_kernel.h"
 #include "raster/src/quad_kernel.h"
 #include "raster/src/texture_kernel.h"
@@ -100,6 +101,74 @@ TEST(Simd, LightKernelMatchesScalarBitForBit) {
             for (int l = 0; l < lanes; ++l)
                 ASSERT_EQ(std::memcmp(&a.rgb[c][l], &b.rgb[c][l], sizeof(float)), 0)
                     << i << " lane " << l << ": " << a.rgb[c][l] << " vs " << b.rgb[c][l];
+    }
+}
+
+// The fragment kernel's AVX2 build gives the scalar build's bits in every lane asked for: lanes
+// passed, base colour, emissive, world position, normal and opacity, for every combination of
+// vertex colours, normals, back faces, alpha modes and textures.
+TEST(Simd, FragmentKernelMatchesScalarBitForBit) {
+    const raster::FragmentKernel wide = raster::fragmentKernelAvx2();
+    if (!wide || !__builtin_cpu_supports("avx2"))
+        GTEST_SKIP() << "no AVX2 kernel on this build or CPU";
+    uint32_t state = 4242u;
+    auto unit = [&state] {
+        state = state * 1664525u + 1013904223u;
+        return float(state >> 8) / 16777216.0f;
+    };
+    for (int i = 0; i < 20000; ++i) {
+        raster::FragmentTriangle tri;
+        for (int k = 0; k < 3; ++k) {
+            for (int c = 0; c < 4; ++c)
+                tri.color[c][k] = unit();
+            for (int c = 0; c < 3; ++c) {
+                tri.world[c][k] = 20.0f * unit() - 10.0f;
+                tri.normal[c][k] = 2.0f * unit() - 1.0f;
+            }
+        }
+        for (int c = 0; c < 4; ++c)
+            tri.base_factor[c] = 1.5f * unit() - 0.25f; // alpha below 0 and above 1 too
+        for (int c = 0; c < 3; ++c) {
+            tri.emissive_factor[c] = i % 3 ? 0.0f : 2.0f * unit();
+            tri.face_normal[c] = 2.0f * unit() - 1.0f;
+        }
+        tri.alpha_cutoff = unit();
+        tri.has_colors = i & 1;
+        tri.has_normals = i & 2;
+        tri.flip_normal = i & 4;
+        tri.mask = (i % 5) == 1;
+        tri.blend = (i % 5) == 2;
+        alignas(32) float persp[3][raster::kQuadLanes];
+        alignas(32) float base_texel[4][raster::kQuadLanes], emissive_texel[4][raster::kQuadLanes];
+        for (int l = 0; l < raster::kQuadLanes; ++l) {
+            const float b0 = unit(), b1 = unit() * (1.0f - b0);
+            persp[0][l] = b0, persp[1][l] = b1, persp[2][l] = 1.0f - b0 - b1;
+            for (int c = 0; c < 4; ++c)
+                base_texel[c][l] = unit(), emissive_texel[c][l] = unit();
+        }
+        const uint32_t lanes = (state >> 4) & 0xffu;
+        const bool base_textured = i & 8, emissive_textured = i & 16;
+        raster::LightLanes a{}, b{};
+        alignas(32) float alpha_a[raster::kQuadLanes] = {}, alpha_b[raster::kQuadLanes] = {};
+        const uint32_t passed_a = raster::fragmentKernelScalar(
+            tri, persp, base_textured ? base_texel : nullptr,
+            emissive_textured ? emissive_texel : nullptr, lanes, a, alpha_a);
+        const uint32_t passed_b =
+            wide(tri, persp, base_textured ? base_texel : nullptr,
+                 emissive_textured ? emissive_texel : nullptr, lanes, b, alpha_b);
+        ASSERT_EQ(passed_a, passed_b) << i;
+        ASSERT_EQ(passed_a & ~lanes, 0u) << i;
+        for (int l = 0; l < raster::kQuadLanes; ++l) {
+            if (!(lanes & (1u << l)))
+                continue;
+            ASSERT_EQ(std::memcmp(&alpha_a[l], &alpha_b[l], sizeof(float)), 0) << i;
+            for (int c = 0; c < 3; ++c) {
+                ASSERT_EQ(std::memcmp(&a.albedo[c][l], &b.albedo[c][l], sizeof(float)), 0) << i;
+                ASSERT_EQ(std::memcmp(&a.emissive[c][l], &b.emissive[c][l], sizeof(float)), 0) << i;
+                ASSERT_EQ(std::memcmp(&a.world[c][l], &b.world[c][l], sizeof(float)), 0) << i;
+                ASSERT_EQ(std::memcmp(&a.normal[c][l], &b.normal[c][l], sizeof(float)), 0) << i;
+            }
+        }
     }
 }
 
