@@ -16,6 +16,15 @@ using raster::Status;
 
 namespace {
 
+// What the render callbacks of accum and multiview read to reuse the kept pinhole frame; they
+// capture `this` and a pointer to it, which std::function stores without allocating.
+struct PinholeCall {
+    const raster::Scene& scene;
+    const raster::RenderOptions& options;
+    FrameReport& report;
+    bool kept;
+};
+
 double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -283,12 +292,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         // The first render is the pinhole (lens centre) into the output frame: the kept one is
         // copied there instead.
         // The callback captures two pointers, which std::function stores without allocating.
-        const struct {
-            const raster::Scene& scene;
-            const raster::RenderOptions& options;
-            FrameReport& report;
-            bool kept;
-        } call{scene, options, report, kept};
+        const PinholeCall call{scene, options, report, kept};
         const RenderFn render_view = [this, &call](const raster::View& v,
                                                    raster::Frame& f) -> Status {
             if (&f == &accum_ && call.kept && pinholeMatches(call.scene, v, call.options)) {
@@ -374,12 +378,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         shading.scene = &scene;
         shading.simd = options.simd;
         // The callbacks capture two pointers, which std::function stores without allocating.
-        const struct {
-            const raster::Scene& scene;
-            const raster::RenderOptions& options;
-            FrameReport& report;
-            bool kept;
-        } call{scene, options, report, kept};
+        const PinholeCall call{scene, options, report, kept};
         const PinholeFn render_pinhole = [this, &call](const raster::View& v,
                                                        raster::Frame& f) -> Status {
             if (&f == &pinhole_ && call.kept && pinholeMatches(call.scene, v, call.options)) {
