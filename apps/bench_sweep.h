@@ -8,9 +8,8 @@
 
 namespace focal {
 
-// One parameter setting of a method: a label and the `focal render` options it adds. A method's
-// settings always pass the same option names, because the table methods keep their option values
-// between parses (apps/dof_method.h: the args object is owned by the entry).
+// One parameter setting of a method: a label and the `focal render` options it adds, spelled from
+// the method's settings table (apps/settings_options.h) so that a sweep names settings fields.
 struct Setting {
     std::string label;
     std::vector<std::string> args;

@@ -1,8 +1,9 @@
 // How `focal render --method NAME` runs a depth-of-field method that lives in dof/: each method
 // adds its own options to the render command, turns them into its dof::MethodSettings and, after
 // each frame rendered by dof::FrameRenderer, writes its --stats parameters and counts and its
-// debug files. The table of methods is in apps/methods.cpp (one line per method);
-// render_command.cpp dispatches through it.
+// debug files. Each `focal render` command line makes its own table of methods
+// (makeMethodTable, apps/methods.cpp: one line per method), which holds that command line's option
+// values; render_command.cpp dispatches through it.
 #pragma once
 
 #include <dof/frame_renderer.h>
@@ -45,8 +46,8 @@ struct MethodOutput {
 struct MethodEntry {
     std::string name;
     std::string summary; // one line for --help
-    // Adds the method's options to `focal render` (values live in the method's own statics-free
-    // args object owned by the entry).
+    // Adds the method's options to `focal render`: its settings table's
+    // (apps/settings_options.h) and its files. The values live in an args object the entry owns.
     std::function<void(CLI::App& render)> add_options;
     // The settings of one frame from the options; fails on values the parser cannot judge. The
     // settings may point into the entry's args object (kept until the next call).
@@ -63,13 +64,13 @@ struct MethodEntry {
         minimum_bytes;
 };
 
-// The methods beyond pinhole and accum, in a fixed order (apps/methods.cpp).
-std::vector<MethodEntry>& methodTable();
+// The methods beyond pinhole and accum, in a fixed order, each with fresh option values.
+std::vector<MethodEntry> makeMethodTable();
 
 // Every `--method` name: pinhole and accum, then the table's methods in order.
 std::vector<std::string> methodNames();
 
-// The table's entry for `name`; null for pinhole, accum and unknown names.
-const MethodEntry* findMethod(const std::string& name);
+// The entry of `table` for `name`; null for pinhole, accum and unknown names.
+const MethodEntry* findMethod(const std::vector<MethodEntry>& table, const std::string& name);
 
 } // namespace focal

@@ -1,12 +1,11 @@
 #include "apps/method_multilayer.h"
 
 #include "apps/image_io.h"
+#include "apps/settings_options.h"
 
 #include <dof/multilayer.h>
 
-#include <charconv>
 #include <cmath>
-#include <limits>
 #include <memory>
 #include <string>
 #include <variant>
@@ -18,15 +17,8 @@ namespace {
 
 // Values of the multilayer options (owned by the entry, shared by its two functions).
 struct MultilayerArgs {
-    dof::MultilayerSettings settings;
-    std::string stack_levels = "auto";
-    std::string truncate = "on";
-    std::string skip_hidden = "on";
-    std::string blend = "additive";
-    std::string filter = "aperture";
-    std::string merge_depth = "mean";
-    std::string additive_gap = "1";
-    std::string levels_out; // prefix of the per-level contribution images (Fig. 7)
+    dof::MultilayerSettings settings; // the table's options (dof::multilayerParams)
+    std::string levels_out;           // prefix of the per-level contribution images (Fig. 7)
 };
 
 const char* kindName(dof::LevelKind k) {
@@ -46,37 +38,6 @@ const char* kindName(dof::LevelKind k) {
 raster::Result<dof::MethodSettings> multilayerSettings(const MultilayerArgs& args,
                                                        const MethodContext& in) {
     dof::MultilayerSettings settings = args.settings;
-    if (args.stack_levels == "auto") {
-        settings.stack_levels = -1;
-    } else {
-        uint32_t v = 0;
-        const char* first = args.stack_levels.data();
-        const char* last = first + args.stack_levels.size();
-        const std::from_chars_result r = std::from_chars(first, last, v);
-        if (r.ec != std::errc() || r.ptr != last || v > dof::kMaxFilterLevels)
-            return raster::Status::error("--stack-levels must be a count in [0, " +
-                                         std::to_string(dof::kMaxFilterLevels) +
-                                         "] or 'auto', got '" + args.stack_levels + "'");
-        settings.stack_levels = int32_t(v);
-    }
-    settings.truncate = args.truncate == "on";
-    settings.skip_hidden = args.skip_hidden == "on";
-    settings.blend = args.blend == "additive" ? dof::LayerBlend::Additive : dof::LayerBlend::Over;
-    settings.filter =
-        args.filter == "aperture" ? dof::LevelFilter::Aperture : dof::LevelFilter::Box;
-    settings.mean_depth = args.merge_depth == "mean";
-    if (args.additive_gap == "inf") {
-        settings.additive_gap = std::numeric_limits<float>::infinity();
-    } else {
-        const char* first = args.additive_gap.data();
-        const char* last = first + args.additive_gap.size();
-        // The range is checked with the other settings (dof::validate).
-        const std::from_chars_result r = std::from_chars(first, last, settings.additive_gap);
-        if (r.ec != std::errc() || r.ptr != last)
-            return raster::Status::error("--additive-gap must be a relative depth gap >= 0 or "
-                                         "'inf', got '" +
-                                         args.additive_gap + "'");
-    }
     settings.color_format = in.target_color.value_or(raster::ColorFormat::Half);
     settings.depth_format = in.target_depth.value_or(raster::DepthFormat::Float32);
     settings.level_contributions = !args.levels_out.empty();
@@ -106,23 +67,14 @@ raster::Status finishMultilayer(const MultilayerArgs& args, const dof::MethodSet
         }
     }
 
-    out.params = {
-        {"fragments_per_pixel", settings.fragments_per_pixel},
-        {"skip_hidden", settings.skip_hidden},
-        {"mip_levels", st.mip_levels},
-        {"stack_levels", st.stack_levels},
-        {"stack_levels_option", args.stack_levels},
-        {"epsilon", settings.epsilon},
-        {"truncate", settings.truncate},
-        {"blend", args.blend},
-        {"level_filter", args.filter},
-        {"merge_depth", args.merge_depth},
-        {"additive_gap", args.additive_gap},
-        {"aperture_grids", settings.aperture_grids},
-        {"second_moment", st.second_moment},
-        {"color_format", settings.color_format == raster::ColorFormat::Half ? "half" : "float32"},
-        {"depth_format",
-         settings.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"}};
+    out.params = settingsJson(dof::multilayerParams(), settings);
+    out.params["mip_levels_used"] = st.mip_levels;
+    out.params["stack_levels_used"] = st.stack_levels;
+    out.params["second_moment"] = st.second_moment;
+    out.params["color_format"] =
+        settings.color_format == raster::ColorFormat::Half ? "half" : "float32";
+    out.params["depth_format"] =
+        settings.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32";
     auto levelJson = [](const dof::MultilayerLevelStats& l) {
         nlohmann::json j = {{"level", l.index},
                             {"kind", kindName(l.kind)},
@@ -184,67 +136,7 @@ MethodEntry makeMultilayerMethod() {
     e.name = "multilayer";
     e.summary = "Selgrad et al. 2015: filtered per-pixel fragment lists (docs/dof/multilayer.md)";
     e.add_options = [args](CLI::App& render) {
-        *args = MultilayerArgs{}; // each new command line starts from the defaults
-        render
-            .add_option("--fragments-per-pixel", args->settings.fragments_per_pixel,
-                        "multilayer: closest N fragments kept per pixel (§4; 0 = all)")
-            ->default_val(4);
-        render
-            .add_option("--mip-levels", args->settings.mip_levels,
-                        "multilayer: mip-mapping steps before the filter stack (§5.2 Y-map)")
-            ->default_val(1);
-        render
-            .add_option("--stack-levels", args->stack_levels,
-                        "multilayer: stack filtering steps, or 'auto' (enough levels for the "
-                        "largest circle of confusion)")
-            ->default_val("auto");
-        render
-            .add_option("--epsilon", args->settings.epsilon,
-                        "multilayer: depth threshold for merging fragments, relative to depth "
-                        "(§5.1)")
-            ->default_val(0.2f);
-        render
-            .add_option("--skip-hidden", args->skip_hidden,
-                        "multilayer: the closest N skip fragments within --epsilon behind an "
-                        "opaque fragment of their pixel (off: the paper's closest N of all, §4; "
-                        "no effect with --fragments-per-pixel 0)")
-            ->check(CLI::IsMember({"on", "off"}))
-            ->default_val("on");
-        render
-            .add_option("--truncate", args->truncate, "multilayer: fragment list truncation (§6.2)")
-            ->check(CLI::IsMember({"on", "off"}))
-            ->default_val("on");
-        render
-            .add_option("--multilayer-blend", args->blend,
-                        "multilayer: front-to-back blending of the traversed slices (§6.1, §7)")
-            ->check(CLI::IsMember({"over", "additive"}))
-            ->default_val("additive");
-        render
-            .add_option("--additive-gap", args->additive_gap,
-                        "multilayer: additive blending within groups of slices whose depths are "
-                        "within a factor 1+G of the previous one, the over operator between "
-                        "groups ('inf': the paper's one group)")
-            ->default_val("1");
-        render
-            .add_option("--merge-depth", args->merge_depth,
-                        "multilayer: the depth of a merged fragment: mean (weighted by opacity) "
-                        "or nearest (the paper's, §5.1)")
-            ->check(CLI::IsMember({"mean", "nearest"}))
-            ->default_val("mean");
-        render
-            .add_option("--level-filter", args->filter,
-                        "multilayer: the blur the traversed levels stand for: aperture (levels "
-                        "shaped like the lens aperture, --aperture-shape) or box (the paper's "
-                        "2^S boxes)")
-            ->check(CLI::IsMember({"aperture", "box"}))
-            ->default_val("aperture");
-        render
-            .add_option("--aperture-grids", args->settings.aperture_grids,
-                        "multilayer: taps per axis of the aperture levels built from each box "
-                        "level (increasing, each below twice the first; one level per grid and "
-                        "octave of blur)")
-            ->delimiter(',')
-            ->default_str("4,5,6");
+        addSettingsOptions(render, "multilayer", dof::multilayerParams(), args->settings);
         render.add_option("--multilayer-levels-out", args->levels_out,
                           "multilayer: write each level's contribution (Fig. 7) to "
                           "PREFIXlevelS.png and PREFIXbackground.png");

@@ -1,6 +1,7 @@
 #include "apps/method_multiview.h"
 
 #include "apps/image_io.h"
+#include "apps/settings_options.h"
 
 #include <dof/multiview.h>
 #include <dof/n_buffer.h>
@@ -12,7 +13,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,24 +24,7 @@ namespace focal {
 namespace {
 
 struct MultiviewArgs {
-    float layer_spacing = 2.0f;
-    uint32_t layers = 0;
-    float overlap = 0.1f;
-    uint32_t iterations = 3;
-    uint32_t refine_steps = 4;
-    std::string traversal = "scan";
-    std::string bound_init = "off";
-    std::string thickness = "0.5";
-    std::string cone = "on";
-    std::string cone_misses = "on";
-    std::string cone_centre = "cell";
-    std::string culling = "on";
-    std::string precompute_paths = "on";
-    std::string jitter = "none";
-    std::string routing = "max-vertex";
-    std::string offscreen = "clamp";
-    bool view_dependent = false;
-    std::string cone_shading = "footprint";
+    dof::MultiviewSettings settings; // the table's options (dof::multiviewParams)
     std::string env_map;
     float env_intensity = 1.0f;
     std::string debug_out;   // prefix of the debug pictures; empty: none
@@ -252,57 +235,8 @@ raster::Status writeDebugPictures(const std::string& prefix, const raster::View&
     return lens.write(prefix + "_lens.png");
 }
 
-const char* jitterName(dof::JitterMode j) {
-    switch (j) {
-    case dof::JitterMode::None:
-        return "none";
-    case dof::JitterMode::Noise:
-        return "noise";
-    case dof::JitterMode::Halton:
-        return "halton";
-    case dof::JitterMode::Rotate:
-        return "rotate";
-    }
-    return "?";
-}
-
-// --thickness: a positive number of CoC pixels, or "inf" (the paper's height field).
-std::optional<float> parseThickness(const std::string& text) {
-    if (text == "inf")
-        return INFINITY;
-    char* end = nullptr;
-    const float v = std::strtof(text.c_str(), &end);
-    if (text.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0.0f))
-        return std::nullopt;
-    return v;
-}
-
 raster::Result<dof::MethodSettings> multiviewSettings(MultiviewArgs& a, const MethodContext& in) {
-    dof::MultiviewSettings s;
-    s.layer_spacing_px = a.layer_spacing;
-    s.layers = a.layers;
-    s.overlap = a.overlap;
-    s.iterations = a.iterations;
-    s.refine_steps = a.refine_steps;
-    s.traversal = a.traversal == "scan" ? dof::Traversal::Scan : dof::Traversal::FalsePosition;
-    s.bound_init = a.bound_init == "on";
-    s.thickness_px = parseThickness(a.thickness).value_or(INFINITY); // checked when parsed
-    s.cone = a.cone == "on";
-    s.cone_misses = a.cone_misses == "on";
-    s.cone_centre = a.cone_centre == "cell" ? dof::ConeCentre::Cell : dof::ConeCentre::Sample;
-    s.culling = a.culling == "on";
-    s.precompute_paths = a.precompute_paths == "on";
-    s.jitter = a.jitter == "none"     ? dof::JitterMode::None
-               : a.jitter == "halton" ? dof::JitterMode::Halton
-               : a.jitter == "rotate" ? dof::JitterMode::Rotate
-                                      : dof::JitterMode::Noise;
-    s.routing = a.routing == "per-fragment" ? raster::LayerRouting::PerFragment
-                                            : raster::LayerRouting::MaxVertexDepth;
-    s.offscreen =
-        a.offscreen == "clamp" ? dof::OffscreenPolicy::Clamp : dof::OffscreenPolicy::Discard;
-    s.view_dependent = a.view_dependent;
-    s.cone_shading =
-        a.cone_shading == "centre" ? dof::ConeShading::Centre : dof::ConeShading::Footprint;
+    dof::MultiviewSettings s = a.settings;
     s.color_format = in.target_color.value_or(raster::ColorFormat::Half);
     s.depth_format = in.target_depth.value_or(raster::DepthFormat::Float32);
 
@@ -358,32 +292,14 @@ raster::Status finishMultiview(MultiviewArgs& a, const MethodContext& in,
             !ds.ok())
             return raster::Status::error("--multiview-debug-out: " + ds.message());
     }
-    out.params = {
-        {"samples", in.lens_samples.size()},
-        {"layer_spacing_px", st.delta_px},
-        {"layer_spacing_requested_px", a.layer_spacing},
-        {"layers_requested", a.layers},
-        {"overlap", a.overlap},
-        {"iterations", a.iterations},
-        {"refine_steps", a.refine_steps},
-        {"traversal", a.traversal},
-        {"bound_init", s.bound_init},
-        {"thickness_px", a.thickness},
-        {"cone", s.cone},
-        {"cone_misses", s.cone_misses},
-        {"cone_centre", a.cone_centre},
-        {"culling", s.culling},
-        {"precompute_paths", s.precompute_paths},
-        {"skip_unblurred", s.skip_unblurred},
-        {"jitter", jitterName(s.jitter)},
-        {"routing", a.routing},
-        {"offscreen", a.offscreen},
-        {"view_dependent", s.view_dependent},
-        {"cone_shading", a.cone_shading},
-        {"env_map", a.env_map},
-        {"env_intensity", a.env_intensity},
-        {"layer_color", s.color_format == raster::ColorFormat::Half ? "half" : "float32"},
-        {"layer_depth", s.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32"}};
+    out.params = settingsJson(dof::multiviewParams(), s);
+    out.params["samples"] = in.lens_samples.size();
+    out.params["layer_spacing_used_px"] = st.delta_px;
+    out.params["env_map"] = a.env_map;
+    out.params["env_intensity"] = a.env_intensity;
+    out.params["layer_color"] = s.color_format == raster::ColorFormat::Half ? "half" : "float32";
+    out.params["layer_depth"] =
+        s.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32";
     if (st.skipped)
         std::fprintf(stderr, "focal: note: multiview rendered the pinhole only: %s\n",
                      st.skip_reason.c_str());
@@ -425,91 +341,7 @@ MethodEntry makeMultiviewMethod() {
     e.name = "multiview";
     e.summary = "Lee, Eisemann & Seidel 2009: lens rays traced through depth layers";
     e.add_options = [args](CLI::App& cmd) {
-        *args = MultiviewArgs{}; // each new command line starts from the defaults
-        cmd.add_option("--layer-spacing", args->layer_spacing,
-                       "multiview: CoC growth delta between layers in pixels (Lee Sec. 4.1, "
-                       "Eq. 4); the layer count follows (at most 64)")
-            ->capture_default_str();
-        cmd.add_option("--layers", args->layers,
-                       "multiview: layer budget M (overrides --layer-spacing; 0 = from spacing)")
-            ->capture_default_str()
-            ->check(CLI::Range(0, 64));
-        cmd.add_option("--overlap", args->overlap, "multiview: layer overlap fraction (Sec. 4.2)")
-            ->capture_default_str()
-            ->check(CLI::Range(0.0, 1.0));
-        cmd.add_option("--iterations", args->iterations,
-                       "multiview: false-position iterations per layer (Sec. 4.3)")
-            ->capture_default_str()
-            ->check(CLI::Range(0, 64));
-        cmd.add_option("--refine-steps", args->refine_steps,
-                       "multiview: binary-search steps after the false position (Sec. 4.3)")
-            ->capture_default_str()
-            ->check(CLI::Range(0, 32));
-        cmd.add_option("--traversal", args->traversal,
-                       "multiview: height-field intersection: false-position (the paper, Sec. "
-                       "4.3) or scan (every texel on the path, exact; Sec. 6)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"false-position", "scan"}));
-        cmd.add_option("--bound-init", args->bound_init,
-                       "multiview: start the false position from the layer's depth bounds and "
-                       "look up the segment ends only when the first point is empty (Sec. 4.3)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"on", "off"}));
-        cmd.add_option("--thickness", args->thickness,
-                       "multiview: with --traversal scan, how far behind its depth a layer texel "
-                       "is solid, as a CoC difference in pixels; inf = the paper's height field")
-            ->capture_default_str()
-            ->check(CLI::Validator(
-                [](std::string& v) -> std::string {
-                    return parseThickness(v) ? "" : "expected a positive number of pixels or inf";
-                },
-                "PX|inf"));
-        cmd.add_option("--cone", args->cone, "multiview: approximate cone tracing (Sec. 4.4)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"on", "off"}));
-        cmd.add_option("--cone-misses", args->cone_misses,
-                       "multiview: with --cone on, a ray crossing a layer without a hit also looks "
-                       "its cone up there (off: the paper's rule, cones only at hits)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"on", "off"}));
-        cmd.add_option("--cone-centre", args->cone_centre,
-                       "multiview: with --cone on and --jitter none, centre each ray's cone on "
-                       "the centroid of its lens sample's Voronoi cell in the aperture (cell) or "
-                       "on the ray (sample: the paper)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"cell", "sample"}));
-        cmd.add_option("--culling", args->culling,
-                       "multiview: early layer culling with N-buffers (Sec. 4.3)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"on", "off"}));
-        cmd.add_option("--precompute-paths", args->precompute_paths,
-                       "multiview: with --jitter none and the scan, walk each lens ray's path "
-                       "through each layer once per frame, not once per pixel (same image)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"on", "off"}));
-        cmd.add_option("--jitter", args->jitter,
-                       "multiview: per-pixel lens sample variation (Sec. 4.5): none, noise "
-                       "(16 pairwise noise offsets), halton (2N sequence offsets), rotate")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"none", "noise", "halton", "rotate"}));
-        cmd.add_option("--routing", args->routing,
-                       "multiview: layer routing (Sec. 4.2): max-vertex (the paper) or "
-                       "per-fragment (exact)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"max-vertex", "per-fragment"}));
-        cmd.add_option(
-               "--offscreen", args->offscreen,
-               "multiview: rays leaving the image: clamp (read the border texels) or discard (the "
-               "paper)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"discard", "clamp"}));
-        cmd.add_flag("--view-dependent", args->view_dependent,
-                     "multiview: shade every hit from its lens ray's own origin (Sec. 5)");
-        cmd.add_option("--cone-shading", args->cone_shading,
-                       "multiview: with --cone on and per-ray shading, shade the cone's centre "
-                       "texel or average 5 shaded taps of its footprint (Sec. 4.4, 5)")
-            ->capture_default_str()
-            ->check(CLI::IsMember({"centre", "footprint"}));
+        addSettingsOptions(cmd, "multiview", dof::multiviewParams(), args->settings);
         cmd.add_option("--env-map", args->env_map,
                        "multiview: equirectangular environment map for reflections (Sec. 5)");
         cmd.add_option("--env-intensity", args->env_intensity, "multiview: environment map scale")
@@ -530,8 +362,8 @@ MethodEntry makeMultiviewMethod() {
     };
     e.minimum_bytes = [args](const raster::View& view, uint32_t samples, uint32_t workers) {
         dof::MultiviewSettings s;
-        s.layers = args->layers;
-        s.view_dependent = args->view_dependent;
+        s.layers = args->settings.layers;
+        s.view_dependent = args->settings.view_dependent;
         s.color_format = raster::ColorFormat::Half; // the smallest storage: a lower bound
         s.depth_format = raster::DepthFormat::Unorm16;
         return dof::multiviewMinimumBytes(s, view.width, view.height, samples, workers);

@@ -6,26 +6,23 @@
 namespace focal {
 
 // One line per method: `entries.push_back(makeXxxMethod());`, declared in apps/method_xxx.h.
-std::vector<MethodEntry>& methodTable() {
-    static std::vector<MethodEntry> entries = [] {
-        std::vector<MethodEntry> e;
-        e.push_back(makeGatherMethod());
-        e.push_back(makeMultilayerMethod());
-        e.push_back(makeMultiviewMethod());
-        return e;
-    }();
+std::vector<MethodEntry> makeMethodTable() {
+    std::vector<MethodEntry> entries;
+    entries.push_back(makeGatherMethod());
+    entries.push_back(makeMultilayerMethod());
+    entries.push_back(makeMultiviewMethod());
     return entries;
 }
 
 std::vector<std::string> methodNames() {
     std::vector<std::string> names = {"pinhole", "accum"};
-    for (const MethodEntry& m : methodTable())
+    for (const MethodEntry& m : makeMethodTable())
         names.push_back(m.name);
     return names;
 }
 
-const MethodEntry* findMethod(const std::string& name) {
-    for (const MethodEntry& m : methodTable())
+const MethodEntry* findMethod(const std::vector<MethodEntry>& table, const std::string& name) {
+    for (const MethodEntry& m : table)
         if (m.name == name)
             return &m;
     return nullptr;

@@ -6,6 +6,7 @@
 #include "apps/render_request.h"
 #include "apps/render_stats.h"
 #include "apps/scene_source.h"
+#include "apps/settings_options.h"
 
 #include <dof/accum.h>
 #include <dof/frame_renderer.h>
@@ -31,8 +32,9 @@ using raster::Status;
 
 namespace {
 
+// Library messages name settings fields; the user reads the options that set them.
 int fail(const std::string& message) {
-    std::fprintf(stderr, "focal: error: %s\n", message.c_str());
+    std::fprintf(stderr, "focal: error: %s\n", withOptionNames(message).c_str());
     return 1;
 }
 
@@ -141,7 +143,7 @@ Result<dof::MethodSettings>
 methodSettings(const RenderJob& job, const dof::LensSampleSet& lens_samples, ProgressBar& bar) {
     if (job.args.method == "accum") {
         dof::AccumMethod accum;
-        accum.settings.pixel_jitter = job.args.pixel_jitter;
+        accum.settings = job.args.accum;
         accum.samples = &lens_samples;
         accum.progress = [&bar](uint32_t done, uint32_t total) { bar.update(done, total); };
         return dof::MethodSettings(std::move(accum));
@@ -254,7 +256,7 @@ int runRender(const RenderArgs& args) {
     if (Status s = checkRenderArgs(args); !s.ok())
         return fail(s.message());
     const bool is_accum = args.method == "accum";
-    const MethodEntry* table_method = findMethod(args.method);
+    const MethodEntry* table_method = findMethod(args.methods, args.method);
     if (args.method == "pinhole" && hasLensOptions(args))
         std::fprintf(stderr, "focal: warning: lens options have no effect with --method %s\n",
                      args.method.c_str());
@@ -294,7 +296,7 @@ int runRender(const RenderArgs& args) {
         args.dry_run ? dof::resolveLens(request, *scene, view, {})
                      : frames.resolveLens(request, *scene, view, options, &runs.counts);
     if (!lens.ok())
-        return fail(withOptionNames(lens.status().message()));
+        return fail(lens.status().message());
     Result<dof::LensSampleSet> lens_samples =
         dof::LensSampleSet::create(*aperture_shape, lensPatternOf(args.lens_pattern),
                                    args.method != "pinhole" ? args.samples : 1, args.seed);

@@ -4,6 +4,9 @@
 // reported by render_stats.h (--stats) and render_dumps.h (--dump-layers, --dump-fragments).
 #pragma once
 
+#include "apps/dof_method.h"
+
+#include <dof/accum.h>
 #include <raster/renderer.h>
 
 #include <CLI/CLI.hpp>
@@ -44,7 +47,7 @@ struct RenderArgs {
     std::optional<std::string> focus_pixel; // "X,Y": focus on the depth seen there
     // Lens sampling (dof/lens_samples.h) and accum (dof/accum.h).
     uint32_t samples = 64;
-    bool pixel_jitter = false;
+    dof::AccumSettings accum; // its table's options (dof::accumParams): --pixel-jitter
     std::string lens_pattern = "hammersley";
     std::optional<std::string> aperture_shape; // circle | polygon | image
     std::optional<uint32_t> aperture_blades;
@@ -66,6 +69,9 @@ struct RenderArgs {
     // override one. Unset: the method's default.
     std::optional<int> precision;
     std::optional<std::string> target_color, target_depth;
+    // The methods beyond pinhole and accum with this command line's option values (their
+    // settings tables' options), made by addRenderCommand.
+    std::vector<MethodEntry> methods;
 };
 
 // Registers the subcommand; `args` must outlive parsing.

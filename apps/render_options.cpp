@@ -1,6 +1,7 @@
 #include "apps/dof_method.h"
 #include "apps/memory_option.h"
 #include "apps/render_command.h"
+#include "apps/settings_options.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -111,8 +112,7 @@ void addLensOptions(CLI::App* cmd, RenderArgs& args) {
     cmd->add_option("--samples", args.samples, "accum: lens samples (views) N")
         ->capture_default_str()
         ->check(CLI::Range(1, 1 << 20));
-    cmd->add_flag("--pixel-jitter", args.pixel_jitter,
-                  "accum: also jitter the sub-pixel position per view (box-filter anti-aliasing)");
+    addSettingsOptions(*cmd, "accum", dof::accumParams(), args.accum);
     cmd->add_option("--lens-pattern", args.lens_pattern, "lens sample pattern")
         ->capture_default_str()
         ->check(CLI::IsMember({"halton", "hammersley", "poisson"}));
@@ -171,8 +171,9 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     addFrameOptions(cmd, args);
     addLensOptions(cmd, args);
     addTargetOptions(cmd, args);
-    // Each method in apps/methods.cpp adds its own options.
-    for (MethodEntry& m : methodTable())
+    // Each method in apps/methods.cpp adds its own options, bound to this command line's table.
+    args.methods = makeMethodTable();
+    for (MethodEntry& m : args.methods)
         if (m.add_options)
             m.add_options(*cmd);
     return cmd;

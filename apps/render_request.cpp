@@ -2,6 +2,7 @@
 
 #include "apps/image_io.h"
 #include "apps/memory_option.h"
+#include "apps/settings_options.h"
 
 #include <glm/geometric.hpp>
 
@@ -91,7 +92,7 @@ Status checkRenderArgs(const RenderArgs& args) {
 bool hasLensOptions(const RenderArgs& args) {
     return args.aperture_radius || args.fstop || args.focus_distance || args.focus_pixel ||
            args.aperture_shape || args.aperture_blades || !args.aperture_image.empty() ||
-           args.pixel_jitter;
+           args.accum.pixel_jitter;
 }
 
 raster::RenderOptions renderOptionsOf(const RenderArgs& args) {
@@ -166,31 +167,6 @@ Result<dof::LensRequest> lensRequestOf(const RenderArgs& args) {
     r.view_focus = args.eye.has_value();
     r.pinhole_image = args.method == "pinhole";
     return r;
-}
-
-std::string withOptionNames(const std::string& message) {
-    static const std::pair<const char*, const char*> kOptions[] = {
-        {"aperture_radius", "--aperture-radius"}, {"fstop", "--fstop"},
-        {"focal_length_mm", "--focal-length"},    {"sensor_height_mm", "--sensor-height"},
-        {"focus_distance", "--focus-distance"},   {"focus_pixel", "--focus-pixel"}};
-    // Whole identifiers only: "fstop" inside another name stays.
-    auto is_ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
-    std::string out;
-    for (size_t i = 0; i < message.size();) {
-        size_t end = i;
-        while (end < message.size() && is_ident(message[end]))
-            ++end;
-        if (end == i) {
-            out += message[i++];
-            continue;
-        }
-        const std::string word = message.substr(i, end - i);
-        const auto* hit = std::find_if(std::begin(kOptions), std::end(kOptions),
-                                       [&](const auto& o) { return word == o.first; });
-        out += hit != std::end(kOptions) ? hit->second : word;
-        i = end;
-    }
-    return out;
 }
 
 Result<dof::ApertureShape> resolveAperture(const RenderArgs& args) {

@@ -1,8 +1,8 @@
 // `focal render`'s options turned into what the library takes: the raster options, the view, the
 // lens request (dof/lens_resolution.h), the lens samples' aperture and pattern, the storage of
 // layered targets and fragment lists. Consumes RenderArgs; produces values the caller owns; reads
-// only the aperture image file. Library messages name settings fields; withOptionNames maps the
-// lens fields back to this command's options.
+// only the aperture image file. Library messages name settings fields; withOptionNames
+// (apps/settings_options.h) maps them back to this command's options.
 #pragma once
 
 #include "apps/render_command.h"
@@ -44,10 +44,6 @@ raster::Result<raster::View> resolveView(const raster::Scene& scene, const Rende
 
 // The lens options as the library's request. Fails only on a malformed --focus-pixel.
 raster::Result<dof::LensRequest> lensRequestOf(const RenderArgs& args);
-
-// `message` with the lens fields (aperture_radius, fstop, focal_length_mm, sensor_height_mm,
-// focus_distance, focus_pixel) replaced by their options (--aperture-radius, ...).
-std::string withOptionNames(const std::string& message);
 
 // The aperture shape of --aperture-shape/-blades/-rotation/-image (reads the image).
 raster::Result<dof::ApertureShape> resolveAperture(const RenderArgs& args);

@@ -1,6 +1,7 @@
 #include "apps/render_stats.h"
 
 #include "apps/report_text.h"
+#include "apps/settings_options.h"
 #include "apps/text_file.h"
 
 #include <cmath>
@@ -15,7 +16,7 @@ constexpr float kPi = 3.14159265358979f;
 
 // The version of the --stats layout (docs/stats-schema.md): bumped on any change that could break
 // a reader (a removed or renamed field, a changed meaning or unit), not for new fields.
-constexpr int kStatsSchemaVersion = 1;
+constexpr int kStatsSchemaVersion = 2; // docs/stats-schema.md: version 2 renamed method params
 
 const char* apertureKindName(dof::ApertureKind k) {
     return k == dof::ApertureKind::Polygon ? "polygon"
@@ -53,11 +54,11 @@ json lensJson(const RenderRecord& r) {
 }
 
 json accumJson(const RenderArgs& args, const dof::AccumStats& a) {
-    json aj = {{"samples", args.samples},
-               {"pixel_jitter", args.pixel_jitter},
-               {"views", a.views},
-               {"renders", a.renders},
-               {"skipped", a.skipped}};
+    json aj = settingsJson(dof::accumParams(), args.accum);
+    aj["samples"] = args.samples;
+    aj["views"] = a.views;
+    aj["renders"] = a.renders;
+    aj["skipped"] = a.skipped;
     if (a.skipped)
         aj["skip_reason"] = a.skip_reason;
     if (a.coc.covered)

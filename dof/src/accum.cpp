@@ -46,7 +46,7 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
     if (Status s = validate(lens, view); !s.ok())
         return s;
     if (samples.size() == 0)
-        return Status::error("--samples must be at least 1");
+        return Status::error("accum: the lens sample set is empty");
     AccumStats stats;
     using Clock = std::chrono::steady_clock;
 

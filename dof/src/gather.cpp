@@ -232,22 +232,6 @@ CocAffine cocAffine(const ThinLens& lens, const raster::View& view) {
     return ca;
 }
 
-Status validate(const GatherSettings& s) {
-    if (!(s.max_radius_px >= 1.0f && s.max_radius_px <= 256.0f))
-        return Status::error("--gather-max-radius must be in [1, 256] pixels, got " +
-                             std::to_string(s.max_radius_px));
-    if (!(s.leak_scale >= 0.0f) || !std::isfinite(s.leak_scale))
-        return Status::error("--gather-leak-scale must be a finite number >= 0, got " +
-                             std::to_string(s.leak_scale));
-    if (!(s.min_radius_px > 0.0f && s.min_radius_px <= 1.0f))
-        return Status::error("--gather-min-radius must be in (0, 1] pixels, got " +
-                             std::to_string(s.min_radius_px));
-    if (s.tile_size < 8 || s.tile_size > 256 || s.tile_size % 8 != 0)
-        return Status::error("gather tile size must be a multiple of 8 in [8, 256], got " +
-                             std::to_string(s.tile_size));
-    return {};
-}
-
 namespace {
 
 Status checkAll(const GatherImage& image, const ThinLens& lens, const raster::View& view,

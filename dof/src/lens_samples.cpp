@@ -206,10 +206,10 @@ raster::Result<ApertureSampler> ApertureSampler::create(const ApertureShape& sha
     s.shape_ = shape;
     if (shape.kind == ApertureKind::Polygon) {
         if (shape.blades < 3 || shape.blades > 64)
-            return Status::error("--aperture-blades must be between 3 and 64, got " +
+            return Status::error("aperture shape: blades must be in [3, 64], got " +
                                  std::to_string(shape.blades));
         if (!std::isfinite(shape.rotation_deg))
-            return Status::error("--aperture-rotation must be a finite angle in degrees");
+            return Status::error("aperture shape: rotation_deg must be a finite angle in degrees");
         const double rot = double(shape.rotation_deg) * 3.14159265358979323846 / 180.0;
         for (uint32_t k = 0; k < shape.blades; ++k) {
             const double a = rot + 3.14159265358979323846 / 2.0 +
@@ -295,7 +295,7 @@ glm::vec2 ApertureSampler::map(glm::vec2 u) const {
 raster::Result<LensSampleSet> LensSampleSet::create(const ApertureShape& shape, LensPattern pattern,
                                                     uint32_t count, uint32_t seed) try {
     if (count == 0)
-        return Status::error("--samples must be at least 1");
+        return Status::error("lens samples: count must be at least 1");
     raster::Result<ApertureSampler> sampler = ApertureSampler::create(shape);
     if (!sampler.ok())
         return sampler.status();

@@ -212,43 +212,6 @@ MultilayerLevelStats levelStats(const FragmentLevel& l) {
 
 } // namespace
 
-raster::Status validate(const MultilayerSettings& s) {
-    using raster::Status;
-    if (s.fragments_per_pixel > 1024)
-        return Status::error("--fragments-per-pixel must be in [0, 1024] (0 keeps every "
-                             "fragment), got " +
-                             std::to_string(s.fragments_per_pixel));
-    if (s.stack_levels < -1)
-        return Status::error("--stack-levels must be a count >= 0 or 'auto'");
-    const uint32_t stack = s.stack_levels < 0 ? 0u : uint32_t(s.stack_levels);
-    if (s.mip_levels > kMaxFilterLevels || s.mip_levels + stack > kMaxFilterLevels)
-        return Status::error("--mip-levels + --stack-levels must be at most " +
-                             std::to_string(kMaxFilterLevels) + ", got " +
-                             std::to_string(s.mip_levels) + " + " + std::to_string(stack));
-    if (std::isnan(s.additive_gap) || s.additive_gap < 0.0f)
-        return Status::error("--additive-gap must be a relative depth gap >= 0 (or inf), got " +
-                             std::to_string(s.additive_gap));
-    if (!std::isfinite(s.epsilon) || s.epsilon < 0.0f || s.epsilon > 10.0f)
-        return Status::error("--epsilon must be a relative depth threshold in [0, 10], got " +
-                             std::to_string(s.epsilon));
-    if (!std::isfinite(s.aperture_second_moment) || !(s.aperture_second_moment > 0.0))
-        return Status::error("the aperture's second moment must be positive and finite");
-    if (s.node_capacity == 0)
-        return Status::error("the fragment node capacity must be at least 1");
-    if (s.filter == LevelFilter::Aperture) {
-        const std::vector<uint32_t>& g = s.aperture_grids;
-        bool good = !g.empty() && g.size() <= kMaxApertureGridsPerBox;
-        for (size_t i = 0; good && i < g.size(); ++i)
-            good = g[i] >= 2 && g[i] <= kMaxApertureGrid && g[i] < 2 * g[0] &&
-                   (i == 0 || g[i] > g[i - 1]);
-        if (!good)
-            return Status::error("--aperture-grids must be increasing taps per axis in [2, " +
-                                 std::to_string(kMaxApertureGrid) +
-                                 "], each below twice the first (e.g. 4,5,6)");
-    }
-    return {};
-}
-
 raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens,
                                   glm::vec3 background, const MultilayerSettings& settings,
                                   const CollectFn& collect, raster::TaskPool& pool,

@@ -65,39 +65,6 @@ MultiviewScratch::~MultiviewScratch() = default;
 MultiviewScratch::MultiviewScratch(MultiviewScratch&&) noexcept = default;
 MultiviewScratch& MultiviewScratch::operator=(MultiviewScratch&&) noexcept = default;
 
-Status validate(const MultiviewSettings& s, uint32_t sample_count) {
-    if (sample_count == 0)
-        return Status::error("--samples must be at least 1");
-    if (s.layers == 0 && (!std::isfinite(s.layer_spacing_px) || !(s.layer_spacing_px > 0.0f)))
-        return Status::error("--layer-spacing must be a positive number of pixels");
-    if (s.layers > raster::kMaxLayers)
-        return Status::error("--layers must be at most " + std::to_string(raster::kMaxLayers));
-    if (!std::isfinite(s.overlap) || s.overlap < 0.0f || s.overlap > 1.0f)
-        return Status::error("--overlap must be in [0, 1]");
-    if (std::isnan(s.thickness_px) || !(s.thickness_px > 0.0f))
-        return Status::error("--thickness must be a positive number of pixels or inf");
-    if (s.iterations > 64)
-        return Status::error("--iterations must be at most 64");
-    if (s.refine_steps > 32)
-        return Status::error("--refine-steps must be at most 32");
-    if (s.tile_size == 0 || s.tile_size > 1024)
-        return Status::error("multiview: tile size must be in [1, 1024]");
-    if (s.jitter == JitterMode::Halton) {
-        if (!s.sequence_2n || s.sequence_2n->size() == 0)
-            return Status::error("--jitter halton needs a 2N-sample sequence");
-        if (s.sequence_2n->size() < sample_count)
-            return Status::error("--jitter halton: the sequence must hold at least --samples");
-    }
-    if (s.env_map) {
-        const EnvironmentMap& e = *s.env_map;
-        if (e.width == 0 || e.height == 0 || e.rgb.size() != size_t(e.width) * e.height * 3)
-            return Status::error("--env-map: the image is empty or its size does not match");
-        if (!std::isfinite(e.intensity) || e.intensity < 0.0f)
-            return Status::error("--env-intensity must be a non-negative number");
-    }
-    return {};
-}
-
 raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& lens,
                                                              const DepthRange& range,
                                                              const MultiviewSettings& settings,
@@ -135,7 +102,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         (layers.gbuffer.size() != layer_texels || !shading.scene ||
          (layers.hasTransparency() && (layers.transparent_gbuffer.size() != layer_texels ||
                                        layers.transparent_top_alpha.size() != layer_texels))))
-        return Status::error("--view-dependent needs layers rendered with a G-buffer");
+        return Status::error("multiview settings: view_dependent needs layers rendered with a "
+                             "G-buffer");
 
     MultiviewStats stats;
     const uint32_t m = layers.layer_count;

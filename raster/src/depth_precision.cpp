@@ -61,12 +61,12 @@ std::optional<std::string> depthPrecisionProblem(const View& view, DepthFormat f
     if (far_d >= last)
         return prefix + " stores every distance beyond " + number(last) +
                " as the far plane, but the scene reaches " + number(far_d) + ": surfaces beyond " +
-               number(last) + " are not drawn (raise --near" +
+               number(last) + " are not drawn (raise the view's znear" +
                (format == DepthFormat::Unorm16 ? " or use float32 depth)" : ")");
     const float step = depthResolution(view, format, far_d);
     if (step > 0.1f * far_d)
         return prefix + " resolves distances near " + number(far_d) + " only to " + number(step) +
-               ": surfaces closer together than that compare equal (raise --near" +
+               ": surfaces closer together than that compare equal (raise the view's znear" +
                (format == DepthFormat::Unorm16 ? " or use float32 depth)" : ")");
     return std::nullopt;
 }

@@ -41,7 +41,7 @@ Status checkMemory(const MemoryBudget& budget, std::string_view what, uint64_t n
         return {};
     return Status::error(std::string(what) + " needs " + formatBytes(needed) +
                          ", more than the memory budget of " + formatBytes(budget.bytes) +
-                         " (--memory-budget)");
+                         " (memory_budget)");
 }
 
 uint64_t mulBytes(uint64_t a, uint64_t b) {

@@ -198,7 +198,7 @@ std::string sizeText(const View& view) {
 // The one message for an allocation that failed although the budget admitted it.
 Status outOfMemory(const std::string& what) {
     return Status::error("out of memory allocating " + what +
-                         " (lower --memory-budget to fail before allocating)");
+                         " (lower the memory_budget to fail before allocating)");
 }
 
 } // namespace

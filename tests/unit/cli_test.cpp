@@ -306,7 +306,8 @@ TEST_F(Cli, DepthOutputMustBeExr) {
 }
 
 TEST_F(Cli, BadMultilayerSettingsNameTheOption) {
-    // Values CLI11 accepts as text but the method rejects: exit 1, one line naming the option.
+    // Values outside the settings table's range or spelling: rejected while parsing (a usage
+    // error, exit 2), one line naming the option.
     for (const std::vector<std::string>& extra :
          {std::vector<std::string>{"--additive-gap", "-1"},
           std::vector<std::string>{"--additive-gap", "wide"},
@@ -314,7 +315,7 @@ TEST_F(Cli, BadMultilayerSettingsNameTheOption) {
         std::vector<std::string> args = renderArgs({"--method", "multilayer"});
         args.insert(args.end(), extra.begin(), extra.end());
         const ProcessResult r = focal(args);
-        EXPECT_TRUE(failedWithOneErrorLine(r, 1)) << extra[0] << " " << extra[1];
+        EXPECT_TRUE(failedWithOneErrorLine(r, 2)) << extra[0] << " " << extra[1];
         EXPECT_TRUE(contains(r.err, extra[0])) << r.err;
         EXPECT_TRUE(files().empty()) << ::testing::PrintToString(files());
     }

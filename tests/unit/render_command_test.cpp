@@ -37,12 +37,12 @@ TEST(RenderCommand, MethodOptionsStartFromTheirDefaultsOnEveryParse) {
     const nlohmann::json first = renderStats(
         {"--method", "multiview", "--samples", "4", "--layers", "8", "--thickness", "inf"},
         dir.string());
-    EXPECT_EQ(first["params"]["layers_requested"], 8);
+    EXPECT_EQ(first["params"]["layers"], 8);
     EXPECT_EQ(first["params"]["thickness_px"], "inf");
     const nlohmann::json second =
         renderStats({"--method", "multiview", "--samples", "4"}, dir.string());
-    EXPECT_EQ(second["params"]["layers_requested"], 0);
-    EXPECT_EQ(second["params"]["thickness_px"], "0.5");
+    EXPECT_EQ(second["params"]["layers"], 0);
+    EXPECT_EQ(second["params"]["thickness_px"], 0.5);
     const nlohmann::json third =
         renderStats({"--method", "multilayer", "--epsilon", "0.5"}, dir.string());
     const nlohmann::json fourth = renderStats({"--method", "multilayer"}, dir.string());

@@ -2,6 +2,7 @@
 // library's field names in messages mapped back to the options, so the command line still names
 // what the user typed (checked on the messages of `focal render` run as a child process).
 #include "apps/render_request.h"
+#include "apps/settings_options.h"
 #include "support/subprocess.h"
 
 #include <gtest/gtest.h>

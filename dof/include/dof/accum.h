@@ -11,6 +11,7 @@
 
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
+#include <dof/settings_table.h>
 #include <raster/camera.h>
 #include <raster/frame.h>
 #include <raster/status.h>
@@ -18,6 +19,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,9 @@ struct AccumSettings {
     // centred): a box filter over each pixel. Off: pixels are point-sampled at their centres.
     bool pixel_jitter = false;
 };
+
+// The parameters of AccumSettings (settings_table.h).
+std::span<const Param<AccumSettings>> accumParams();
 
 struct AccumStats {
     uint32_t views = 0;   // lens views averaged (0 when skipped)

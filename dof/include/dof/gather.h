@@ -17,6 +17,7 @@
 #pragma once
 
 #include <dof/lens.h>
+#include <dof/settings_table.h>
 #include <raster/camera.h>
 #include <raster/status.h>
 #include <raster/storage.h>
@@ -25,6 +26,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace dof {
@@ -84,8 +86,12 @@ struct GatherSettings {
     bool simd = true;
 };
 
+// The parameters of GatherSettings a caller chooses (settings_table.h). Not in it: tile_size and
+// simd, which dof::FrameRenderer takes from the raster options.
+std::span<const Param<GatherSettings>> gatherParams();
+
 // Rejects NaN, R outside [1, 256], leak_scale < 0, min_radius outside (0, 1], bad tile sizes.
-// Messages name the command-line options.
+// Messages name the fields ("gather settings: max_radius_px must be in [1, 256], got 0").
 raster::Status validate(const GatherSettings& settings);
 
 struct GatherStats {

@@ -12,6 +12,7 @@
 #include <dof/fragment_levels.h>
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
+#include <dof/settings_table.h>
 #include <raster/camera.h>
 #include <raster/fragment_lists.h>
 #include <raster/memory_budget.h>
@@ -23,6 +24,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -92,7 +94,13 @@ struct MultilayerSettings {
     raster::MemoryBudget memory_budget;
 };
 
-// Rejects bad settings with a message naming the command-line option.
+// The parameters of MultilayerSettings a caller chooses (settings_table.h). Not in it, because
+// the caller or dof::FrameRenderer sets them: the aperture and its second moment (from the lens
+// samples), the storage formats, node_capacity, level_contributions and the memory budget.
+std::span<const Param<MultilayerSettings>> multilayerParams();
+
+// Rejects bad settings: every parameter of the table in its range, then the checks between them
+// (messages "multilayer settings: NAME ...", naming the fields).
 raster::Status validate(const MultilayerSettings& settings);
 
 // One level built this frame: a box level of the hierarchy or an aperture level.

@@ -19,6 +19,7 @@
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
 #include <dof/n_buffer.h>
+#include <dof/settings_table.h>
 #include <raster/camera.h>
 #include <raster/frame.h>
 #include <raster/layered_target.h>
@@ -31,6 +32,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -287,7 +289,13 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
                 raster::Frame* pinhole_out = nullptr, raster::LayeredTarget* layers_out = nullptr,
                 MultiviewScratch* scratch = nullptr);
 
-// Validates settings alone (ranges of every option, messages naming them).
+// The parameters of MultiviewSettings a caller chooses (settings_table.h), in the order --help
+// lists them. Not in it, because the caller or dof::FrameRenderer sets them: the storage formats,
+// seed, sequence_2n, env_map, tile_size and the debug fields.
+std::span<const Param<MultiviewSettings>> multiviewParams();
+
+// Validates settings alone: every parameter of the table in its range, then the checks between
+// them (messages "multiview settings: NAME ...", naming the fields).
 raster::Status validate(const MultiviewSettings& settings, uint32_t sample_count);
 
 // A lower bound of the bytes renderMultiview holds for a width x height image with

@@ -306,7 +306,7 @@ TEST(Gather, SameBitsForEveryThreadCountAndTileSize) {
             }
 }
 
-TEST(Gather, RejectsBadInputWithTheOptionName) {
+TEST(Gather, RejectsBadInputWithTheSettingName) {
     const raster::View view = pixelView(32, 32, kFocus);
     raster::Frame f = noiseFrame(view, raster::DepthFormat::Float32, 20.0f, 300.0f);
     const dof::ThinLens lens = dof::makeThinLens(view, 4.0f, kFocus);
@@ -317,15 +317,15 @@ TEST(Gather, RejectsBadInputWithTheOptionName) {
     };
     GatherSettings s;
     s.max_radius_px = 0.5f;
-    EXPECT_NE(message(s).find("--gather-max-radius"), std::string::npos);
+    EXPECT_NE(message(s).find("gather settings: max_radius_px"), std::string::npos);
     s.max_radius_px = NAN;
-    EXPECT_NE(message(s).find("--gather-max-radius"), std::string::npos);
+    EXPECT_NE(message(s).find("gather settings: max_radius_px"), std::string::npos);
     s = {};
     s.leak_scale = -1.0f;
-    EXPECT_NE(message(s).find("--gather-leak-scale"), std::string::npos);
+    EXPECT_NE(message(s).find("gather settings: leak_scale"), std::string::npos);
     s = {};
     s.min_radius_px = 0.0f;
-    EXPECT_NE(message(s).find("--gather-min-radius"), std::string::npos);
+    EXPECT_NE(message(s).find("gather settings: min_radius_px"), std::string::npos);
     s = {};
     s.tile_size = 12;
     EXPECT_NE(message(s).find("tile"), std::string::npos);

@@ -58,18 +58,18 @@ TEST(LayerSpacing, PinholeAndFlatScenesGetOneLayer) {
     EXPECT_LT(s->bounds[0], s->bounds[1]);
 }
 
-TEST(LayerSpacing, BadParametersNameTheOption) {
+TEST(LayerSpacing, BadParametersNameTheSetting) {
     const raster::View view = pixelView(64, 48, 100.0f);
     const dof::ThinLens lens = dof::makeThinLens(view, 10.0f, 100.0f);
     const dof::DepthRange range{40.0f, 400.0f, true};
     raster::Result<dof::LayerSpacing> s = dof::layerSpacingFromDelta(lens, range, 0.0f, 64);
     ASSERT_FALSE(s.ok());
-    EXPECT_NE(s.status().message().find("--layer-spacing"), std::string::npos);
+    EXPECT_NE(s.status().message().find("multiview settings: layer_spacing_px"), std::string::npos);
     s = dof::layerSpacingFromDelta(lens, range, NAN, 64);
     EXPECT_FALSE(s.ok());
     s = dof::layerSpacingFromCount(lens, range, 0);
     ASSERT_FALSE(s.ok());
-    EXPECT_NE(s.status().message().find("--layers"), std::string::npos);
+    EXPECT_NE(s.status().message().find("multiview settings: layers"), std::string::npos);
     s = dof::layerSpacingFromCount(lens, dof::DepthRange{}, 4);
     EXPECT_FALSE(s.ok());
 }

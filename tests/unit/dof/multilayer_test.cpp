@@ -709,33 +709,36 @@ TEST(Multilayer, UnreadCellsLeftEmptyGiveTheSameBytes) {
     }
 }
 
-TEST(Multilayer, BadSettingsNameTheOption) {
+TEST(Multilayer, BadSettingsNameTheSetting) {
     dof::MultilayerSettings s;
     s.epsilon = -1.0f;
     raster::Status st = dof::validate(s);
     EXPECT_FALSE(st.ok());
-    EXPECT_NE(st.message().find("--epsilon"), std::string::npos);
+    EXPECT_NE(st.message().find("multilayer settings: epsilon"), std::string::npos);
     s = {};
     s.mip_levels = 10;
     s.stack_levels = 10;
     st = dof::validate(s);
-    EXPECT_NE(st.message().find("--mip-levels"), std::string::npos);
+    EXPECT_NE(st.message().find("multilayer settings: mip_levels"), std::string::npos);
     s = {};
     s.fragments_per_pixel = 5000;
-    EXPECT_NE(dof::validate(s).message().find("--fragments-per-pixel"), std::string::npos);
+    EXPECT_NE(dof::validate(s).message().find("multilayer settings: fragments_per_pixel"),
+              std::string::npos);
     s = {};
     s.epsilon = NAN;
     EXPECT_FALSE(dof::validate(s).ok());
     s = {};
     s.aperture_grids = {4, 9};
-    EXPECT_NE(dof::validate(s).message().find("--aperture-grids"), std::string::npos);
+    EXPECT_NE(dof::validate(s).message().find("multilayer settings: aperture_grids"),
+              std::string::npos);
     s.aperture_grids = {4, 8}; // not below twice the first
     EXPECT_FALSE(dof::validate(s).ok());
     s.aperture_grids = {5, 4};
     EXPECT_FALSE(dof::validate(s).ok());
     s = {};
     s.additive_gap = NAN;
-    EXPECT_NE(dof::validate(s).message().find("--additive-gap"), std::string::npos);
+    EXPECT_NE(dof::validate(s).message().find("multilayer settings: additive_gap"),
+              std::string::npos);
 }
 
 } // namespace

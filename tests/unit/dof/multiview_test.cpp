@@ -822,34 +822,39 @@ TEST(Multiview, AbsurdBlurIsAnErrorNotACrash) {
     EXPECT_NE(r.status().message().find("2^24 pixels"), std::string::npos) << r.status().message();
 }
 
-TEST(Multiview, BadSettingsNameTheOption) {
+TEST(Multiview, BadSettingsNameTheSetting) {
     const dof::LensSampleSet samples = makeSamples(8);
     dof::MultiviewSettings s;
     s.overlap = 2.0f;
-    EXPECT_NE(dof::validate(s, 8).message().find("--overlap"), std::string::npos);
+    EXPECT_NE(dof::validate(s, 8).message().find("multiview settings: overlap"), std::string::npos);
     s = {};
     s.layer_spacing_px = -1.0f;
-    EXPECT_NE(dof::validate(s, 8).message().find("--layer-spacing"), std::string::npos);
+    EXPECT_NE(dof::validate(s, 8).message().find("multiview settings: layer_spacing_px"),
+              std::string::npos);
     s = {};
     s.layers = 65;
-    EXPECT_NE(dof::validate(s, 8).message().find("--layers"), std::string::npos);
+    EXPECT_NE(dof::validate(s, 8).message().find("multiview settings: layers"), std::string::npos);
     s = {};
     s.iterations = 1000;
-    EXPECT_NE(dof::validate(s, 8).message().find("--iterations"), std::string::npos);
+    EXPECT_NE(dof::validate(s, 8).message().find("multiview settings: iterations"),
+              std::string::npos);
     s = {};
     s.thickness_px = 0.0f;
-    EXPECT_NE(dof::validate(s, 8).message().find("--thickness"), std::string::npos);
+    EXPECT_NE(dof::validate(s, 8).message().find("multiview settings: thickness_px"),
+              std::string::npos);
     s = {};
     s.jitter = dof::JitterMode::Halton;
-    EXPECT_NE(dof::validate(s, 8).message().find("--jitter halton"), std::string::npos);
+    EXPECT_NE(dof::validate(s, 8).message().find("multiview settings: jitter halton"),
+              std::string::npos);
     s.sequence_2n = &samples;
     EXPECT_TRUE(dof::validate(s, 8).ok());
-    EXPECT_NE(dof::validate(dof::MultiviewSettings{}, 0).message().find("--samples"),
-              std::string::npos);
+    EXPECT_NE(
+        dof::validate(dof::MultiviewSettings{}, 0).message().find("multiview settings: samples"),
+        std::string::npos);
     dof::EnvironmentMap env;
     s = {};
     s.env_map = &env;
-    EXPECT_NE(dof::validate(s, 8).message().find("--env-map"), std::string::npos);
+    EXPECT_NE(dof::validate(s, 8).message().find("multiview settings: env_map"), std::string::npos);
 }
 
 TEST(Multiview, HaltonJitterUsesTheTwoNSequence) {

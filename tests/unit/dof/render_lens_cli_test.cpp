@@ -102,7 +102,7 @@ TEST_F(RenderLensCli, AccumRecordsTheLensInStats) {
     std::ifstream in(stats);
     const nlohmann::json j = nlohmann::json::parse(in);
     EXPECT_EQ(j["schema"], "focal.render-stats");
-    EXPECT_EQ(j["schema_version"], 1);
+    EXPECT_EQ(j["schema_version"], 2);
     EXPECT_NEAR(j["lens"]["aperture_radius"].get<double>(), 0.05 / 2.8, 1e-6);
     EXPECT_EQ(j["lens"]["aperture_source"], "fstop");
     EXPECT_EQ(j["lens"]["focus_source"], "focus-pixel");

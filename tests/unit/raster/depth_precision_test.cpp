@@ -57,7 +57,7 @@ TEST(DepthPrecision, ProblemNamesTheNumbers) {
     ASSERT_TRUE(problem.has_value());
     EXPECT_EQ(*problem, "unorm16 depth with near 1e-05 stores every distance beyond 1.31 as the "
                         "far plane, but the scene reaches 25: surfaces beyond 1.31 are not drawn "
-                        "(raise --near or use float32 depth)");
+                        "(raise the view's znear or use float32 depth)");
     // Float depth (D = -n/d, reversed-Z) keeps them, 24 bits apart at any distance.
     EXPECT_FALSE(raster::depthPrecisionProblem(viewWithNear(1e-5f), DepthFormat::Float32, 2.0f,
                                                25.0f, "depth"));

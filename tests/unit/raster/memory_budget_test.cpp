@@ -12,7 +12,7 @@ TEST(MemoryBudget, NamesWhatNeededHowMuch) {
     const raster::Status s = raster::checkMemory(budget, "multiview scratch", uint64_t{3} << 30);
     ASSERT_FALSE(s.ok());
     EXPECT_EQ(s.message(), "multiview scratch needs 3.0 GiB, more than the memory budget of "
-                           "1.0 GiB (--memory-budget)");
+                           "1.0 GiB (memory_budget)");
     EXPECT_TRUE(raster::checkMemory(raster::MemoryBudget{}, "anything", ~uint64_t{0}).ok());
 }
 
