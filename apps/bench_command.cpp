@@ -107,6 +107,7 @@ struct SceneRuns {
     const BenchArgs& args;
     const BenchScene& scene;
     std::vector<std::string> common; // the scene, the size and its lens options
+    const LoadedScene& loaded;       // the scene, loaded once for all its runs
     const Reference& ref;
     fs::path out;
 };
@@ -153,20 +154,17 @@ Result<Json> runCase(const SceneRuns& c, const std::string& method, const Settin
     const BenchArgs& args = c.args;
     const std::string id = safeName(c.scene.name + "_" + method + "_" + setting.label + "_t" +
                                     std::to_string(threads));
-    const std::string exr = (c.out / "runs" / (id + ".exr")).string();
     std::vector<std::string> a = c.common;
     if (method == "pinhole") // it has no lens: drop the lens options (and the warning)
         a.resize(5);
     a.insert(a.end(), {"--threads", std::to_string(threads), "--method", method, "--repeat",
-                       std::to_string(args.repeat), "-o", exr});
+                       std::to_string(args.repeat)});
     a.insert(a.end(), setting.args.begin(), setting.args.end());
-    RenderRun r = renderInProcess(a, (c.out / "runs" / (id + ".json")).string());
+    RenderRun r = renderInMemory(a, &c.loaded);
     if (r.exit_code != 0)
         return Status::error(c.scene.spec + ": --method " + method + " " + setting.label +
                              " failed");
-    Result<ImageData> img = readImage(exr);
-    if (!img.ok())
-        return img.status();
+    const ImageData* img = &r.image;
     Json row;
     row["scene"] = c.scene.spec;
     row["study"] = study;
@@ -257,12 +255,13 @@ Status runScalingStudy(const SceneRuns& c, BenchResults& results, Progress& prog
 
 // The scene's reference (rendered or cached), its PNG and its results.json "scenes" entry.
 Result<Reference> sceneReference(const BenchArgs& args, const BenchScene& scene,
-                                 const std::vector<std::string>& common, const fs::path& out,
-                                 const std::string& cache, BenchResults& results) {
+                                 const std::vector<std::string>& common, const LoadedScene& loaded,
+                                 const fs::path& out, const std::string& cache,
+                                 BenchResults& results) {
     std::fprintf(stderr, "focal: bench: %s: reference (accum, %u views)...\n", scene.spec.c_str(),
                  args.ref_samples);
     Result<Reference> ref =
-        reference(scene, common, args.ref_samples, args.threads, cache, (out / "runs").string());
+        reference(scene, common, args.ref_samples, args.threads, cache, &loaded);
     if (!ref.ok())
         return ref;
     const std::string ref_png = "images/" + scene.name + "_reference.png";
@@ -417,10 +416,14 @@ int runBench(BenchArgs args) {
         std::vector<std::string> common = {scene.spec, "--width", std::to_string(args.width),
                                            "--height", std::to_string(args.height)};
         common.insert(common.end(), scene.lens.begin(), scene.lens.end());
-        Result<Reference> ref = sceneReference(args, scene, common, out, cache, results);
+        // Loaded once: every run's render time excludes it, and the rows' load_ms is this load's.
+        Result<LoadedScene> loaded = loadBenchScene(common);
+        if (!loaded.ok())
+            return fail(loaded.status().message());
+        Result<Reference> ref = sceneReference(args, scene, common, *loaded, out, cache, results);
         if (!ref.ok())
             return fail(ref.status().message());
-        const SceneRuns runs{args, scene, common, *ref, out};
+        const SceneRuns runs{args, scene, common, *loaded, *ref, out};
         runMainStudy(runs, results, progress);
         if (!args.no_scaling && &scene == &scenes.front())
             if (Status s = runScalingStudy(runs, results, progress); !s.ok())
@@ -429,7 +432,7 @@ int runBench(BenchArgs args) {
     addEqualError(args, scenes, results);
     addScalingEfficiency(results.rows);
     if (args.temporal_frames >= 2 && !scenes.empty()) {
-        Result<Json> temporal = temporalStudy(args, scenes.front(), out.string(), cache);
+        Result<Json> temporal = temporalStudy(args, scenes.front(), cache);
         if (!temporal.ok())
             return fail(temporal.status().message());
         results.temporal = std::move(*temporal);

@@ -42,7 +42,7 @@ dof::ImageRef imageRefOf(const ImageData& img) {
 
 raster::Result<Reference> reference(const BenchScene& scene, const std::vector<std::string>& common,
                                     uint32_t samples, uint32_t threads,
-                                    const std::string& cache_dir, const std::string& tmp_dir) {
+                                    const std::string& cache_dir, const LoadedScene* loaded) {
     Reference ref;
     const std::string keytext = referenceKeyText(scene, common, samples);
     ref.key = hexHash(keytext);
@@ -57,13 +57,17 @@ raster::Result<Reference> reference(const BenchScene& scene, const std::vector<s
             ref.ms = j["time_ms"].value("total", 0.0);
     } else {
         std::vector<std::string> args = common;
-        args.insert(args.end(),
-                    {"--method", "accum", "--samples", std::to_string(samples), "-o", color_path,
-                     "--depth-out", depth_path, "--threads", std::to_string(threads)});
-        RenderRun r = renderInProcess(args, (fs::path(tmp_dir) / "ref_stats.json").string());
+        args.insert(args.end(), {"--method", "accum", "--samples", std::to_string(samples),
+                                 "--depth-out", depth_path, "--threads", std::to_string(threads)});
+        RenderRun r = renderInMemory(args, loaded);
         if (r.exit_code != 0)
             return raster::Status::error("the reference render of " + scene.spec + " failed");
         r.stats["bench_key"] = keytext;
+        // The cache: the images, then the record that says they are complete.
+        if (raster::Status s = writeImage(color_path, r.image); !s.ok())
+            return s;
+        if (raster::Status s = writeImage(depth_path, r.depth); !s.ok())
+            return s;
         if (raster::Status s = writeTextFile(base + ".json", r.stats.dump(2) + "\n"); !s.ok())
             return s;
         ref.ms = r.stats["time_ms"].value("total", 0.0);

@@ -7,6 +7,7 @@
 
 #include "apps/bench_scene.h"
 #include "apps/image_io.h"
+#include "apps/render_command.h"
 
 #include <dof/metrics.h>
 #include <raster/status.h>
@@ -35,10 +36,10 @@ struct Reference {
 
 // Renders (or loads from `cache_dir`) `accum` with `samples` views for `common` render options
 // (the scene spec first). `threads` is not part of the key: the bits do not depend on it
-// (docs/architecture.md, "Threads"). `tmp_dir` receives the render's stats file.
+// (docs/architecture.md, "Threads"). `loaded`: the scene, loaded for `common`.
 raster::Result<Reference> reference(const BenchScene& scene, const std::vector<std::string>& common,
                                     uint32_t samples, uint32_t threads,
-                                    const std::string& cache_dir, const std::string& tmp_dir);
+                                    const std::string& cache_dir, const LoadedScene* loaded);
 
 // A view of `img`'s pixels for dof/metrics.h; valid while `img` is.
 dof::ImageRef imageRefOf(const ImageData& img);

@@ -1,6 +1,7 @@
 #include "apps/bench_render.h"
 
 #include "apps/render_command.h"
+#include "apps/settings_options.h"
 
 #include <CLI/CLI.hpp>
 
@@ -13,7 +14,6 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <limits>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -44,54 +44,58 @@ double statusMiB(const char* field) {
     return 0.0;
 }
 
-// Runs `run` with stdout sent to /dev/null (runRender prints its "wrote" line there).
-int withoutStdout(const std::function<int()>& run) {
-    std::fflush(stdout);
-    const int saved = ::dup(1);
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    if (saved >= 0 && devnull >= 0)
-        ::dup2(devnull, 1);
-    const int code = run();
-    std::fflush(stdout);
-    if (saved >= 0 && devnull >= 0)
-        ::dup2(saved, 1);
-    if (devnull >= 0)
-        ::close(devnull);
-    if (saved >= 0)
-        ::close(saved);
-    return code;
-}
-
-} // namespace
-
-RenderRun renderInProcess(const std::vector<std::string>& args, const std::string& stats_path) {
-    RenderRun r;
-    CLI::App app;
-    RenderArgs ra;
+// Parses `focal render ARGS --no-progress -o -` into `ra`; the -o is dropped after parsing (CLI11
+// requires one; the bench keeps images in memory).
+bool parseRenderArgs(const std::vector<std::string>& args, CLI::App& app, RenderArgs& ra) {
     addRenderCommand(app, ra);
     std::vector<std::string> argv = {"render"};
     argv.insert(argv.end(), args.begin(), args.end());
-    argv.insert(argv.end(), {"--stats", stats_path, "--no-progress"});
+    argv.insert(argv.end(), {"--no-progress", "-o", "-"});
     std::reverse(argv.begin(), argv.end()); // CLI11 parses a vector back to front
     try {
         app.parse(argv);
     } catch (const CLI::ParseError& e) {
         std::fprintf(stderr, "focal: error: bench made a bad render command: %s\n", e.what());
+        return false;
+    }
+    ra.outputs.clear();
+    return true;
+}
+
+} // namespace
+
+RenderRun renderInMemory(const std::vector<std::string>& args, const LoadedScene* scene) {
+    RenderRun r;
+    CLI::App app;
+    RenderArgs ra;
+    if (!parseRenderArgs(args, app, ra)) {
         r.exit_code = 2;
         return r;
     }
     if (!resetPeakRss())
         r.peak_scope = "process";
     r.start_rss_mib = statusMiB("VmRSS:");
-    r.exit_code = withoutStdout([&] { return runRender(ra); });
+    raster::Result<RenderedFrame> frame = renderFrame(ra, scene);
     r.peak_rss_mib = statusMiB("VmHWM:");
-    if (r.exit_code == 0) {
-        std::ifstream f(stats_path);
-        r.stats = nlohmann::ordered_json::parse(f, nullptr, false);
-        if (r.stats.is_discarded())
-            r.exit_code = 1;
+    if (!frame.ok()) {
+        std::fprintf(stderr, "focal: error: %s\n",
+                     withOptionNames(frame.status().message()).c_str());
+        r.exit_code = 1;
+        return r;
     }
+    r.image = ImageData{frame->width, frame->height, 4, std::move(frame->color)};
+    if (!frame->depth.empty())
+        r.depth = ImageData{frame->width, frame->height, 1, std::move(frame->depth)};
+    r.stats = nlohmann::ordered_json::parse(frame->stats.dump());
     return r;
+}
+
+raster::Result<LoadedScene> loadBenchScene(const std::vector<std::string>& args) {
+    CLI::App app;
+    RenderArgs ra;
+    if (!parseRenderArgs(args, app, ra))
+        return raster::Status::error("bench made a bad render command");
+    return loadSceneFor(ra);
 }
 
 double timeRenderProcess(const std::vector<std::string>& args) {

@@ -75,26 +75,21 @@ raster::Result<std::vector<ImageData>> methodFrames(const BenchArgs& args, const
                                                     const std::string& method,
                                                     const Setting& setting,
                                                     const std::vector<ImageData>& refs,
-                                                    const fs::path& out, double& psnr_sum) {
+                                                    const LoadedScene& loaded, double& psnr_sum) {
     std::vector<ImageData> frames;
     for (uint32_t k = 0; k < args.temporal_frames; ++k) {
-        const std::string exr = (out / "runs" / ("temporal_" + safeName(method) + ".exr")).string();
         std::vector<std::string> a = frameArgs(args, scene, k);
         if (method == "pinhole")
             a.resize(a.size() - 4); // no lens: drop --aperture-radius, --focus-distance
-        a.insert(a.end(),
-                 {"--threads", std::to_string(args.threads), "--method", method, "-o", exr});
+        a.insert(a.end(), {"--threads", std::to_string(args.threads), "--method", method});
         a.insert(a.end(), setting.args.begin(), setting.args.end());
-        RenderRun r = renderInProcess(a, (out / "runs" / "temporal_stats.json").string());
+        RenderRun r = renderInMemory(a, &loaded);
         if (r.exit_code != 0)
             return raster::Status::error(scene.spec + ": temporal frame of " + method + " failed");
-        raster::Result<ImageData> img = readImage(exr);
-        if (!img.ok())
-            return img.status();
         raster::Result<dof::ErrorMetrics> m =
-            dof::compareImages(imageRefOf(*img), imageRefOf(refs[k]));
+            dof::compareImages(imageRefOf(r.image), imageRefOf(refs[k]));
         psnr_sum += m.ok() && std::isfinite(m->psnr_srgb_db) ? m->psnr_srgb_db : 100.0;
-        frames.push_back(std::move(*img));
+        frames.push_back(std::move(r.image));
     }
     return frames;
 }
@@ -102,15 +97,18 @@ raster::Result<std::vector<ImageData>> methodFrames(const BenchArgs& args, const
 } // namespace
 
 raster::Result<Json> temporalStudy(const BenchArgs& args, const BenchScene& scene,
-                                   const std::string& out_dir, const std::string& cache_dir) {
-    const fs::path out(out_dir);
+                                   const std::string& cache_dir) {
     const uint32_t k_frames = args.temporal_frames;
+    // The scene, loaded once for every frame (they differ in camera and lens only).
+    raster::Result<LoadedScene> loaded = loadBenchScene(frameArgs(args, scene, 0));
+    if (!loaded.ok())
+        return loaded.status();
     std::vector<ImageData> refs;
     for (uint32_t k = 0; k < k_frames; ++k) {
         std::fprintf(stderr, "focal: bench: temporal reference frame %u/%u\n", k + 1, k_frames);
         raster::Result<Reference> r =
             reference(scene, frameArgs(args, scene, k), args.temporal_ref_samples, args.threads,
-                      cache_dir, (out / "runs").string());
+                      cache_dir, &*loaded);
         if (!r.ok())
             return r.status();
         refs.push_back(std::move(r->color));
@@ -127,7 +125,7 @@ raster::Result<Json> temporalStudy(const BenchArgs& args, const BenchScene& scen
         const Setting setting = studySetting(method, args.quick, &Setting::temporal);
         double psnr_sum = 0.0;
         raster::Result<std::vector<ImageData>> frames =
-            methodFrames(args, scene, method, setting, refs, out, psnr_sum);
+            methodFrames(args, scene, method, setting, refs, *loaded, psnr_sum);
         if (!frames.ok())
             return frames.status();
         double flicker = 0.0, extra = 0.0;

@@ -3,8 +3,8 @@
 // at its study setting against accum references of the same frames. Flicker of a sequence = mean
 // over frame pairs of the mean |I_k - I_k-1| (linear RGB); the excess flicker compares each
 // method's frame differences with the reference's. Consumes the bench's arguments and scene;
-// produces one JSON row per method (caller-owned); writes its renders under OUT/runs and its
-// references into the cache.
+// produces one JSON row per method (caller-owned); renders in memory, with the scene loaded
+// once, and writes its references into the cache.
 #pragma once
 
 #include "apps/bench_command.h"
@@ -18,6 +18,6 @@
 namespace focal {
 
 raster::Result<Json> temporalStudy(const BenchArgs& args, const BenchScene& scene,
-                                   const std::string& out_dir, const std::string& cache_dir);
+                                   const std::string& cache_dir);
 
 } // namespace focal

@@ -224,37 +224,54 @@ void printDryRun(const RenderArgs& args, const dof::ResolvedLens& lens,
 }
 
 // -o (every file) and --depth-out.
-Status writeOutputs(const RenderArgs& args, const raster::View& view, std::vector<float> color,
-                    std::vector<float> depth) {
-    const ImageData color_out{view.width, view.height, 4, std::move(color)};
+Status writeOutputs(const RenderArgs& args, const RenderedFrame& frame) {
+    const ImageData color_out{frame.width, frame.height, 4, frame.color};
     for (const std::string& output : args.outputs)
         if (Status s = writeImage(output, color_out); !s.ok())
             return s;
     if (args.depth_out.empty())
         return {};
     // The method's depth (dof::FrameImage::depth): the pinhole's for pinhole, accum and gather.
-    return writeImage(args.depth_out, ImageData{view.width, view.height, 1, std::move(depth)});
+    return writeImage(args.depth_out, ImageData{frame.width, frame.height, 1, frame.depth});
 }
 
-void printWrote(const RenderArgs& args, const raster::View& view, const RunsResult& runs) {
+void printWrote(const RenderArgs& args, const RenderedFrame& frame) {
     std::printf("focal: wrote %s", args.outputs.front().c_str());
     for (size_t i = 1; i < args.outputs.size(); ++i)
         std::printf(", %s", args.outputs[i].c_str());
     if (!args.depth_out.empty())
         std::printf(" and %s", args.depth_out.c_str());
     if (args.method == "accum")
-        std::printf(" (%ux%u, accum %u views, %.1f ms)\n", view.width, view.height,
-                    runs.accum.views, runs.times.medianTotal());
+        std::printf(" (%ux%u, accum %u views, %.1f ms)\n", frame.width, frame.height,
+                    frame.accum_views, frame.ms_median);
     else
-        std::printf(" (%ux%u, %s, %.1f ms)\n", view.width, view.height, args.method.c_str(),
-                    runs.times.medianTotal());
+        std::printf(" (%ux%u, %s, %.1f ms)\n", frame.width, frame.height, args.method.c_str(),
+                    frame.ms_median);
+}
+
+// What a loaded scene depends on besides the file: the textures the shading samples and the
+// memory budget they are loaded under.
+std::string sceneKey(const RenderArgs& args) {
+    return args.scene + "\n" + args.shading + "\n" + args.memory_budget;
 }
 
 } // namespace
 
-int runRender(const RenderArgs& args) {
+Result<LoadedScene> loadSceneFor(const RenderArgs& args) {
+    const raster::RenderOptions options = renderOptionsOf(args);
+    raster::TaskPool pool(args.threads);
+    LoadedScene loaded;
+    loaded.key = sceneKey(args);
+    Result<raster::Scene> scene = loadRenderScene(args, options, pool, loaded.load);
+    if (!scene.ok())
+        return scene.status();
+    loaded.scene = std::move(*scene);
+    return loaded;
+}
+
+Result<RenderedFrame> renderFrame(const RenderArgs& args, const LoadedScene* loaded) {
     if (Status s = checkRenderArgs(args); !s.ok())
-        return fail(s.message());
+        return s;
     const bool is_accum = args.method == "accum";
     const MethodEntry* table_method = findMethod(args.methods, args.method);
     if (args.method == "pinhole" && hasLensOptions(args))
@@ -263,29 +280,34 @@ int runRender(const RenderArgs& args) {
     const dof::LensRequest request = lensRequestOf(args).value(); // checked above
     Result<dof::ApertureShape> aperture_shape = resolveAperture(args);
     if (!aperture_shape.ok())
-        return fail(aperture_shape.status().message());
+        return aperture_shape.status();
     const raster::RenderOptions options = renderOptionsOf(args);
     raster::TaskPool pool(args.threads);
-    raster::ImportStats load_stats;
-    Result<raster::Scene> scene = loadRenderScene(args, options, pool, load_stats);
-    if (!scene.ok())
-        return fail(scene.status().message());
-    Result<raster::View> camera = resolveView(*scene, args);
+    LoadedScene own;
+    if (!loaded || loaded->key != sceneKey(args)) {
+        Result<raster::Scene> scene = loadRenderScene(args, options, pool, own.load);
+        if (!scene.ok())
+            return scene.status();
+        own.scene = std::move(*scene);
+        loaded = &own;
+    }
+    const raster::Scene& scene = loaded->scene;
+    Result<raster::View> camera = resolveView(scene, args);
     if (!camera.ok())
-        return fail(camera.status().message());
+        return camera.status();
     // A focal length implies the field of view (Blender, vertical sensor fit).
     const raster::View view = dof::photographicView(*camera, request);
     if (Status s = raster::validate(view); !s.ok())
-        return fail(s.message());
+        return s;
     const TargetStorage targets = targetStorageOf(args);
-    warnDepthPrecision(*scene, view, options.depth_format, targets.depth, table_method != nullptr);
+    warnDepthPrecision(scene, view, options.depth_format, targets.depth, table_method != nullptr);
     // Absurd requests fail here, in milliseconds, before any rendering.
     const uint64_t request_bytes =
         requestMinimumBytes(args, view, options, table_method, pool.workerCount());
     if (Status s =
             raster::checkMemory(options.memory_budget, requestText(args, view), request_bytes);
         !s.ok())
-        return fail(s.message());
+        return s;
 
     // Every frame of this command (autofocus, each --repeat run, the dumps) is rendered by one
     // FrameRenderer: it keeps the renderer, the methods' buffers and the pinhole frame. A dry run
@@ -293,56 +315,70 @@ int runRender(const RenderArgs& args) {
     dof::FrameRenderer frames(pool);
     RunsResult runs;
     Result<dof::ResolvedLens> lens =
-        args.dry_run ? dof::resolveLens(request, *scene, view, {})
-                     : frames.resolveLens(request, *scene, view, options, &runs.counts);
+        args.dry_run ? dof::resolveLens(request, scene, view, {})
+                     : frames.resolveLens(request, scene, view, options, &runs.counts);
     if (!lens.ok())
-        return fail(lens.status().message());
+        return lens.status();
     Result<dof::LensSampleSet> lens_samples =
         dof::LensSampleSet::create(*aperture_shape, lensPatternOf(args.lens_pattern),
                                    args.method != "pinhole" ? args.samples : 1, args.seed);
     if (!lens_samples.ok())
-        return fail(lens_samples.status().message());
+        return lens_samples.status();
+    RenderedFrame out;
+    out.width = view.width;
+    out.height = view.height;
     if (args.dry_run) {
         printDryRun(args, *lens, options, request_bytes);
-        return 0;
+        return out;
     }
 
     // The image every run writes (linear RGBA) and the depth --depth-out asks for.
     const size_t pixels = size_t(view.width) * view.height;
-    std::vector<float> color(pixels * 4);
-    std::vector<float> depth(args.depth_out.empty() ? 0 : pixels);
-    const dof::FrameImage image{color.data(), size_t(view.width) * 4,
-                                depth.empty() ? nullptr : depth.data(), view.width};
+    out.color.resize(pixels * 4);
+    out.depth.resize(args.depth_out.empty() ? 0 : pixels);
+    const dof::FrameImage image{out.color.data(), size_t(view.width) * 4,
+                                out.depth.empty() ? nullptr : out.depth.data(), view.width};
     const MethodContext context{lens->view, *lens_samples, options, targets.color, targets.depth};
-    const RenderJob job{args, *scene, options, *lens, table_method, context, frames};
-    if (Status s = renderRuns(job, *lens_samples, image, color, runs); !s.ok())
-        return fail(s.message());
+    const RenderJob job{args, scene, options, *lens, table_method, context, frames};
+    if (Status s = renderRuns(job, *lens_samples, image, out.color, runs); !s.ok())
+        return s;
     if (is_accum && runs.accum.skipped)
         std::fprintf(stderr, "focal: note: accum rendered once: %s\n",
                      runs.accum.skip_reason.c_str());
-    if (Status s = writeOutputs(args, view, std::move(color), std::move(depth)); !s.ok())
-        return fail(s.message());
     Result<nlohmann::json> target_stats =
-        dumpTargets(frames, *scene, lens->view, options, args, targets);
+        dumpTargets(frames, scene, lens->view, options, args, targets);
     if (!target_stats.ok())
-        return fail(target_stats.status().message());
-    if (!args.stats_path.empty()) {
-        const RenderRecord record{args,
-                                  lens->view,
-                                  request,
-                                  *lens,
-                                  *aperture_shape,
-                                  runs.times,
-                                  load_stats,
-                                  runs.counts,
-                                  is_accum ? &runs.accum : nullptr,
-                                  table_method ? &runs.method_out : nullptr,
-                                  targets,
-                                  std::move(*target_stats)};
-        if (Status s = writeRenderStats(args.stats_path, record); !s.ok())
+        return target_stats.status();
+    out.ms_median = runs.times.medianTotal();
+    out.accum_views = is_accum ? runs.accum.views : 0;
+    const RenderRecord record{args,
+                              lens->view,
+                              request,
+                              *lens,
+                              *aperture_shape,
+                              runs.times,
+                              loaded->load,
+                              runs.counts,
+                              is_accum ? &runs.accum : nullptr,
+                              table_method ? &runs.method_out : nullptr,
+                              targets,
+                              std::move(*target_stats)};
+    out.stats = renderStatsJson(record);
+    return out;
+}
+
+int runRender(const RenderArgs& args) {
+    Result<RenderedFrame> frame = renderFrame(args);
+    if (!frame.ok())
+        return fail(frame.status().message());
+    if (args.dry_run)
+        return 0;
+    if (Status s = writeOutputs(args, *frame); !s.ok())
+        return fail(s.message());
+    if (!args.stats_path.empty())
+        if (Status s = writeRenderStats(args.stats_path, frame->stats); !s.ok())
             return fail(s.message());
-    }
-    printWrote(args, view, runs);
+    printWrote(args, *frame);
     return 0;
 }
 

@@ -7,10 +7,14 @@
 #include "apps/dof_method.h"
 
 #include <dof/accum.h>
+#include <raster/gltf_import.h>
 #include <raster/renderer.h>
+#include <raster/scene.h>
+#include <raster/status.h>
 
 #include <CLI/CLI.hpp>
 #include <glm/vec3.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <optional>
@@ -73,6 +77,36 @@ struct RenderArgs {
     // settings tables' options), made by addRenderCommand.
     std::vector<MethodEntry> methods;
 };
+
+// A scene loaded once and rendered many times (focal bench): the scene, what loading took, and
+// the options it was loaded under (the textures the shading samples, the memory budget).
+struct LoadedScene {
+    raster::Scene scene;
+    raster::ImportStats load;
+    std::string key;
+};
+
+// The frame a render command describes, in memory: the image (linear RGBA, top row first), the
+// depth when --depth-out asks for it, and the --stats object (docs/stats-schema.md).
+struct RenderedFrame {
+    uint32_t width = 0, height = 0;
+    std::vector<float> color, depth;
+    nlohmann::json stats;
+    double ms_median = 0.0;   // the median render time over --repeat
+    uint32_t accum_views = 0; // accum: the views averaged
+};
+
+// Loads args.scene as renderFrame does: the textures the shading samples, decoded on
+// args.threads threads.
+raster::Result<LoadedScene> loadSceneFor(const RenderArgs& args);
+
+// Everything `focal render` does but write the -o, --depth-out and --stats files: checks, scene
+// (`loaded` when it was loaded for the same scene, shading and memory budget; else loaded here),
+// view, lens, the --repeat runs on one dof::FrameRenderer, --dump-layers/--dump-fragments. A dry
+// run prints its line and returns an empty image. Failures come back as the library's message
+// (naming settings, not options: withOptionNames turns them into options).
+raster::Result<RenderedFrame> renderFrame(const RenderArgs& args,
+                                          const LoadedScene* loaded = nullptr);
 
 // Registers the subcommand; `args` must outlive parsing.
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args);

@@ -170,14 +170,15 @@ json RunTimes::medians() const {
     return t;
 }
 
-raster::Status writeRenderStats(const std::string& path, const RenderRecord& r) {
+json renderStatsJson(const RenderRecord& r) {
     const RenderArgs& args = r.args;
     const raster::View& v = r.view;
     json j;
     j["schema"] = "focal.render-stats";
     j["schema_version"] = kStatsSchemaVersion;
     j["scene"] = args.scene;
-    j["output"] = args.outputs.front();
+    // No -o: a frame kept in memory (focal bench).
+    j["output"] = args.outputs.empty() ? json() : json(args.outputs.front());
     j["outputs"] = args.outputs;
     j["simd"] = !args.no_simd;
     if (!r.target_stats.is_null())
@@ -215,7 +216,11 @@ raster::Status writeRenderStats(const std::string& path, const RenderRecord& r) 
                       {"setup", r.counts.triangles_setup}};
     j["fragments"] = {{"covered", r.counts.fragments_covered},
                       {"passed", r.counts.fragments_passed}};
-    return writeTextFile(path, j.dump(2) + "\n");
+    return j;
+}
+
+raster::Status writeRenderStats(const std::string& path, const nlohmann::json& stats) {
+    return writeTextFile(path, stats.dump(2) + "\n");
 }
 
 } // namespace focal

@@ -58,6 +58,8 @@ struct RenderRecord {
     nlohmann::json target_stats;            // --dump-layers / --dump-fragments
 };
 
-raster::Status writeRenderStats(const std::string& path, const RenderRecord& record);
+// The --stats object of a render (docs/stats-schema.md), and its file.
+nlohmann::json renderStatsJson(const RenderRecord& record);
+raster::Status writeRenderStats(const std::string& path, const nlohmann::json& stats);
 
 } // namespace focal
