@@ -318,6 +318,16 @@ bool walkPaths(Tracer& tr, MultiviewStats& stats) {
         LayerSeg& seg = tr.segs[l];
         if (seg.empty)
             continue;
+        for (uint32_t k = 0; k < samples.size(); ++k) {
+            const RayPath& path = tr.paths[size_t(k) * m + l];
+            auto& box = seg.paths_box;
+            const bool first = k == 0;
+            box.x0 = first ? path.box_x0 : std::min(box.x0, path.box_x0);
+            box.x1 = first ? path.box_x1 : std::max(box.x1, path.box_x1);
+            box.y0 = first ? path.box_y0 : std::min(box.y0, path.box_y0);
+            box.y1 = first ? path.box_y1 : std::max(box.y1, path.box_y1);
+            seg.long_paths = seg.long_paths || path.count > kRayCullMinCells;
+        }
         seg.focus_t1 = seg.t1;
         for (uint32_t k = 0; k < samples.size(); ++k) {
             const RayPath& path = tr.paths[size_t(k) * m + l];
