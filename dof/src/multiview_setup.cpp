@@ -127,6 +127,7 @@ Status buildSegments(Tracer& tr, const LayerContent& content, MultiviewStats& st
             // level floor(log2 Dc) + 1 at most (and none above the top), 1.5 of its texels
             // either side.
             seg.t_cone = 0.5f * (seg.own0 + seg.own1);
+            seg.coc_cone = tr.cocOf(seg.t_cone);
             const int top = int(kMaxMipLevels) - 1;
             seg.cone_px = 1.5f * std::ldexp(1.0f, std::min(std::ilogb(widest) + 1, top)) + 1.0f;
         }
@@ -289,6 +290,21 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
             seg.first_cone_px = tr.r_max * std::fabs(tr.cocOf(seg.t_cone)) +
                                 1.5f * std::ldexp(1.0f, int(seg.cone_level.l1)) + 1.0f;
         }
+}
+
+void buildFirstRays(Tracer& tr) {
+    if (tr.settings->jitter != JitterMode::None)
+        return;
+    const uint32_t n = tr.samples->size();
+    tr.first_rays.resize(n);
+    for (uint32_t k = 0; k < n; ++k) {
+        RayState& ray = tr.first_rays[k];
+        ray = RayState{};
+        ray.lens = tr.samples->sample(k);
+        ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
+        ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
+        ray.t_end = tr.segs.back().t1;
+    }
 }
 
 bool walkPaths(Tracer& tr, MultiviewStats& stats) {

@@ -132,17 +132,25 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
     if (s.jitter == JitterMode::Halton)
         halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
     const uint32_t n = tr.samples->size();
-    const float t_first = tr.segs.front().t0;
+    const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
     MultiviewRayRecord* records = debugRecords(tr, x, y, n);
+    cnt.rays += n;
+    const bool shared = !tr.first_rays.empty(); // the set's samples, the same for every pixel
+    if (shared) {
+        std::copy_n(tr.first_rays.data(), n, rays);
+        if (!records && s.offscreen != OffscreenPolicy::Discard)
+            return;
+    }
+    const glm::vec2* cone_offsets = tr.cone_offsets.empty() ? nullptr : tr.cone_offsets.data();
     for (uint32_t k = 0; k < n; ++k) {
-        ++cnt.rays;
         RayState& ray = rays[k];
-        ray = RayState{};
-        ray.lens = jitteredSample(tr, x, y, k, noise, halton_offset);
-        ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
-        ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
-        ray.t_end = tr.segs.back().t1;
+        if (!shared) {
+            const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
+            const glm::vec2 w(-ls.position.x, ls.position.y);
+            ray = RayState{ls, w, cone_offsets ? w + cone_offsets[k] : w};
+            ray.t_end = t_last;
+        }
         MultiviewRayRecord* rec = records ? records + k : nullptr;
         if (rec) {
             rec->lens = ray.lens.position;
@@ -196,21 +204,26 @@ struct PixelLayer {
 };
 
 // Ray k of pixel (pl.x, pl.y) through layer pl.l (§4.3-§4.4): its opaque hit or miss, the
-// layer's transparent plane in front of it, and the cone of either.
+// layer's transparent plane in front of it, and the cone of either. kPlain: compiled for the
+// usual case, no per-ray shading, no debug record and no transparent plane in the layer (the
+// same arithmetic, without the tests for them).
+template <bool kPlain>
 void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ray,
-                MultiviewRayRecord* rec, TileCounters& cnt) {
+                MultiviewRayRecord* record, TileCounters& cnt) {
     const MultiviewSettings& s = *tr.settings;
     const raster::View& view = *tr.view;
     const raster::LayeredTarget& lt = *tr.layers;
     const uint32_t x = pl.x, y = pl.y, l = pl.l;
-    const bool shade = pl.shade;
+    const bool shade = !kPlain && pl.shade;
+    MultiviewRayRecord* const rec = kPlain ? nullptr : record;
     const float cx = pl.cx, cy = pl.cy;
     const glm::vec2 w = ray.w, wc = ray.wc;
     // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
     const glm::vec3 shade_from =
-        s.view_dependent ? view.eye + tr.lens->aperture_radius * (ray.lens.position.x * view.right +
-                                                                  ray.lens.position.y * view.up)
-                         : view.eye;
+        !kPlain && s.view_dependent
+            ? view.eye + tr.lens->aperture_radius *
+                             (ray.lens.position.x * view.right + ray.lens.position.y * view.up)
+            : view.eye;
     // §4.4: a cone of coverage v1 and colour c1 gives v1 c1 + (1 - v1) c2, c2 what the rest
     // of the ray sees; from kFullCoverage on it blocks the ray (returns true).
     auto blend = [&](float v1, glm::vec3 c1) {
@@ -279,7 +292,7 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
     // from its mipmap (§4.4).
     const float ta = std::max(s0, seg.own0);
     const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
-    if (can_hit && seg.transparent && ta < tb) {
+    if (!kPlain && can_hit && seg.transparent && ta < tb) {
         const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
         if (ht.hit && miss && miss->t < ht.t)
             addMiss(); // the missed cone's content lies in front of the pane
@@ -358,7 +371,23 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
     const float t_last = tr.segs.back().t1;
     double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
     MultiviewRayRecord* records = debugRecords(tr, x, y);
-    for (uint32_t k = 0; k < tr.samples->size(); ++k) {
+    const uint32_t n = tr.samples->size();
+    // No ray is recorded or discarded (the usual case): the weighted mean alone, as below.
+    const bool plain = !records && s.offscreen != OffscreenPolicy::Discard;
+    for (uint32_t k = 0; plain && k < n; ++k) {
+        const RayState& ray = rays[k];
+        glm::vec3 color = ray.color;
+        if (ray.transmit > 0.0f) {
+            ++cnt.background;
+            color += ray.transmit * tr.background;
+        }
+        const double wt = double(ray.lens.weight);
+        sum_r += wt * double(color.r);
+        sum_g += wt * double(color.g);
+        sum_b += wt * double(color.b);
+        sum_w += wt;
+    }
+    for (uint32_t k = 0; !plain && k < n; ++k) {
         const RayState& ray = rays[k];
         if (ray.discarded)
             continue;
@@ -440,10 +469,14 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                 pxl.setPixel(tr, x, y, (pixel_layers[p].hittable >> l) & 1);
                 RayState* pr = rays + p * n;
                 MultiviewRayRecord* recs = debugRecords(tr, x, y);
+                const bool plain = !pxl.shade && !recs && !pxl.seg->transparent;
                 uint32_t live = 0;
                 for (uint32_t k = 0; k < n; ++k)
                     if (pr[k].transmit > 0.0f) {
-                        traceLayer(tr, pxl, k, pr[k], recs ? recs + k : nullptr, cnt);
+                        if (plain)
+                            traceLayer<true>(tr, pxl, k, pr[k], nullptr, cnt);
+                        else
+                            traceLayer<false>(tr, pxl, k, pr[k], recs ? recs + k : nullptr, cnt);
                         live += pr[k].transmit > 0.0f ? 1 : 0;
                     }
                 if (live == 0)
