@@ -184,6 +184,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
 
     t0 = Clock::now();
     buildMipmaps(tr, reach_max, pool, scratch, stats);
+    buildFirstRays(tr);
     stats.ms_mipmaps = msSince(t0);
     for (uint32_t l = 0; l < m; ++l) {
         for (const std::vector<float>& lv : scratch.nbuffers[l].levels)

@@ -134,10 +134,10 @@ struct MissCone {
 std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w,
                                  bool shade, glm::vec3 eye, TileCounters& cnt) {
     const LayerSeg& seg = tr.segs[l];
-    // Where the ray is at stored depth t: off the image, clamped to its border (as a clamped
-    // ray reads the border texels, OffscreenPolicy::Clamp) or none (Discard).
-    auto at = [&](float t, float& px, float& py) {
-        const float c = tr.cocOf(t);
+    // Where the ray is where its image offset is c (at stored depth t, c = C(t)): off the image,
+    // clamped to its border (as a clamped ray reads the border texels, OffscreenPolicy::Clamp)
+    // or none (Discard).
+    auto at = [&](float c, float& px, float& py) {
         px = cx + c * w.x, py = cy + c * w.y;
         if (tr.inImage(px, py))
             return true;
@@ -148,7 +148,7 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
         return true;
     };
     float px = 0.0f, py = 0.0f;
-    if (!at(seg.t_cone, px, py))
+    if (!at(seg.coc_cone, px, py))
         return std::nullopt;
     const MipChain& owned = tr.owned_mips[l];
     // Most rays pass where the layer owns nothing near them: no coverage, no lookup.
@@ -160,7 +160,7 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
     MissCone cone;
     cone.t = std::clamp(d[0] / d[1], seg.t0, seg.t1);
     const float diameter = tr.lambda * std::fabs(tr.cocOf(cone.t));
-    if (!at(cone.t, px, py) || !(diameter > 1.0f))
+    if (!at(tr.cocOf(cone.t), px, py) || !(diameter > 1.0f))
         return std::nullopt;
     const std::array<float, kOwnedChannels> m =
         sampleMip<kOwnedChannels>(tr, owned, px, py, diameter);

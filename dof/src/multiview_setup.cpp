@@ -127,6 +127,7 @@ Status buildSegments(Tracer& tr, const LayerContent& content, MultiviewStats& st
             // level floor(log2 Dc) + 1 at most (and none above the top), 1.5 of its texels
             // either side.
             seg.t_cone = 0.5f * (seg.own0 + seg.own1);
+            seg.coc_cone = tr.cocOf(seg.t_cone);
             const int top = int(kMaxMipLevels) - 1;
             seg.cone_px = 1.5f * std::ldexp(1.0f, std::min(std::ilogb(widest) + 1, top)) + 1.0f;
         }
@@ -291,6 +292,21 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
         }
 }
 
+void buildFirstRays(Tracer& tr) {
+    if (tr.settings->jitter != JitterMode::None)
+        return;
+    const uint32_t n = tr.samples->size();
+    tr.first_rays.resize(n);
+    for (uint32_t k = 0; k < n; ++k) {
+        RayState& ray = tr.first_rays[k];
+        ray = RayState{};
+        ray.lens = tr.samples->sample(k);
+        ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
+        ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
+        ray.t_end = tr.segs.back().t1;
+    }
+}
+
 bool walkPaths(Tracer& tr, MultiviewStats& stats) {
     const LensSampleSet& samples = *tr.samples;
     const uint32_t m = uint32_t(tr.segs.size());
@@ -318,6 +334,16 @@ bool walkPaths(Tracer& tr, MultiviewStats& stats) {
         LayerSeg& seg = tr.segs[l];
         if (seg.empty)
             continue;
+        for (uint32_t k = 0; k < samples.size(); ++k) {
+            const RayPath& path = tr.paths[size_t(k) * m + l];
+            auto& box = seg.paths_box;
+            const bool first = k == 0;
+            box.x0 = first ? path.box_x0 : std::min(box.x0, path.box_x0);
+            box.x1 = first ? path.box_x1 : std::max(box.x1, path.box_x1);
+            box.y0 = first ? path.box_y0 : std::min(box.y0, path.box_y0);
+            box.y1 = first ? path.box_y1 : std::max(box.y1, path.box_y1);
+            seg.long_paths = seg.long_paths || path.count > kRayCullMinCells;
+        }
         seg.focus_t1 = seg.t1;
         for (uint32_t k = 0; k < samples.size(); ++k) {
             const RayPath& path = tr.paths[size_t(k) * m + l];

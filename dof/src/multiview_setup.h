@@ -68,6 +68,9 @@ void buildNBuffers(const Tracer& tr, raster::TaskPool& pool, MultiviewScratch& s
 void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, MultiviewScratch& scratch,
                   MultiviewStats& stats);
 
+// With the shared sample set (JitterMode::None): tr.first_rays, every ray's starting state.
+void buildFirstRays(Tracer& tr);
+
 // With the shared sample set and the scan: every sample's path through every segment into
 // tr.paths and tr.cells, and each segment's in-focus bounds. False (nothing walked) when the
 // lens makes the paths too long.

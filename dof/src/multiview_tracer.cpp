@@ -18,10 +18,6 @@ namespace {
 
 // Cone coverage at or above this ends the traversal (the cone is fully blocked, §4.4).
 constexpr float kFullCoverage = 0.999f;
-// A path walked in advance is culled per ray only when longer than this: an N-buffer query
-// costs about as much as scanning that many cells (tracing time on demo, dense and foliage at
-// N = 64 with thresholds 0, 4, 8 and never: 8 and never were fastest, 0 slowest by 10-20 %).
-constexpr uint32_t kRayCullMinCells = 8;
 
 // The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
 LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
@@ -136,17 +132,25 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
     if (s.jitter == JitterMode::Halton)
         halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
     const uint32_t n = tr.samples->size();
-    const float t_first = tr.segs.front().t0;
+    const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
     const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
     MultiviewRayRecord* records = debugRecords(tr, x, y, n);
+    cnt.rays += n;
+    const bool shared = !tr.first_rays.empty(); // the set's samples, the same for every pixel
+    if (shared) {
+        std::copy_n(tr.first_rays.data(), n, rays);
+        if (!records && s.offscreen != OffscreenPolicy::Discard)
+            return;
+    }
+    const glm::vec2* cone_offsets = tr.cone_offsets.empty() ? nullptr : tr.cone_offsets.data();
     for (uint32_t k = 0; k < n; ++k) {
-        ++cnt.rays;
         RayState& ray = rays[k];
-        ray = RayState{};
-        ray.lens = jitteredSample(tr, x, y, k, noise, halton_offset);
-        ray.w = glm::vec2(-ray.lens.position.x, ray.lens.position.y);
-        ray.wc = tr.cone_offsets.empty() ? ray.w : ray.w + tr.cone_offsets[k];
-        ray.t_end = tr.segs.back().t1;
+        if (!shared) {
+            const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
+            const glm::vec2 w(-ls.position.x, ls.position.y);
+            ray = RayState{ls, w, cone_offsets ? w + cone_offsets[k] : w};
+            ray.t_end = t_last;
+        }
         MultiviewRayRecord* rec = records ? records + k : nullptr;
         if (rec) {
             rec->lens = ray.lens.position;
@@ -164,21 +168,62 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
     }
 }
 
-// Ray k of pixel (x, y) through layer l (§4.3-§4.4): its opaque hit or miss, the layer's
-// transparent plane in front of it, and the cone of either.
-void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hittable, uint32_t k,
-                RayState& ray, MultiviewRayRecord* rec, TileCounters& cnt) {
+// What every ray of pixel (x, y) shares in layer l (traceLayer): the layer's part is set once
+// per tile layer (setLayer), the pixel's once per pixel and layer (setPixel).
+struct PixelLayer {
+    uint32_t l = 0;
+    const LayerSeg* seg = nullptr;
+    const float* depth = nullptr; // the layer's stored depths
+    bool shade = false;           // hits are shaded per ray (§5)
+    // Sample k's path walked in advance through the whole segment: paths[k * path_stride];
+    // null when the paths are walked per ray.
+    const RayPath* paths = nullptr;
+    size_t path_stride = 0;
+    uint32_t x = 0, y = 0;
+    float cx = 0.0f, cy = 0.0f; // the pixel's centre
+    bool hittable = false;      // PixelLayers::hittable
+    bool paths_inside = false;  // every path of the layer lies in the image around the pixel
+
+    void setLayer(const Tracer& tr, uint32_t layer) {
+        l = layer;
+        seg = &tr.segs[l];
+        depth = tr.scratch->depth[l].data();
+        shade = tr.settings->view_dependent || tr.settings->env_map;
+        paths = tr.paths.empty() ? nullptr : tr.paths.data() + l;
+        path_stride = tr.segs.size();
+    }
+    void setPixel(const Tracer& tr, uint32_t px, uint32_t py, bool can_hit) {
+        x = px, y = py;
+        cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+        hittable = can_hit;
+        const auto& box = seg->paths_box;
+        paths_inside = paths && box.x0 <= box.x1 && int64_t(x) + box.x0 >= 0 &&
+                       int64_t(y) + box.y0 >= 0 && int64_t(x) + box.x1 < int64_t(tr.width) &&
+                       int64_t(y) + box.y1 < int64_t(tr.height);
+    }
+};
+
+// Ray k of pixel (pl.x, pl.y) through layer pl.l (§4.3-§4.4): its opaque hit or miss, the
+// layer's transparent plane in front of it, and the cone of either. kPlain: compiled for the
+// usual case, no per-ray shading, no debug record and no transparent plane in the layer (the
+// same arithmetic, without the tests for them).
+template <bool kPlain>
+void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ray,
+                MultiviewRayRecord* record, TileCounters& cnt) {
     const MultiviewSettings& s = *tr.settings;
     const raster::View& view = *tr.view;
     const raster::LayeredTarget& lt = *tr.layers;
-    const bool shade = s.view_dependent || s.env_map;
-    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    const uint32_t x = pl.x, y = pl.y, l = pl.l;
+    const bool shade = !kPlain && pl.shade;
+    MultiviewRayRecord* const rec = kPlain ? nullptr : record;
+    const float cx = pl.cx, cy = pl.cy;
     const glm::vec2 w = ray.w, wc = ray.wc;
     // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
     const glm::vec3 shade_from =
-        s.view_dependent ? view.eye + tr.lens->aperture_radius * (ray.lens.position.x * view.right +
-                                                                  ray.lens.position.y * view.up)
-                         : view.eye;
+        !kPlain && s.view_dependent
+            ? view.eye + tr.lens->aperture_radius *
+                             (ray.lens.position.x * view.right + ray.lens.position.y * view.up)
+            : view.eye;
     // §4.4: a cone of coverage v1 and colour c1 gives v1 c1 + (1 - v1) c2, c2 what the rest
     // of the ray sees; from kFullCoverage on it blocks the ray (returns true).
     auto blend = [&](float v1, glm::vec3 c1) {
@@ -192,15 +237,15 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
         return false;
     };
     ++cnt.layer_steps;
-    const LayerSeg& seg = tr.segs[l];
+    const LayerSeg& seg = *pl.seg;
     const float s0 = std::max(seg.t0, ray.t_resume);
     if (!(s0 < seg.t1))
         return;
     // The whole segment's path walked in advance, unless the ray resumes inside it.
     const RayPath* path =
-        !tr.paths.empty() && s0 == seg.t0 ? &tr.paths[size_t(k) * tr.segs.size() + l] : nullptr;
-    bool can_hit = hittable;
-    if (can_hit && s.culling && (!path || path->count > kRayCullMinCells)) {
+        pl.paths && s0 == seg.t0 ? pl.paths + size_t(k) * pl.path_stride : nullptr;
+    bool can_hit = pl.hittable;
+    if (can_hit && s.culling && (!path || (seg.long_paths && path->count > kRayCullMinCells))) {
         // Per-ray culling: the texels this ray's segment can read lie in the box of its end
         // points; one N-buffer query skips the height-field test when none of them is within
         // the layer (the same test as §4.3's per-pixel culling, on a smaller window, so it is
@@ -221,8 +266,10 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
     Hit h;
     if (can_hit) {
         ++cnt.layer_tests;
-        h = path ? scanPath(tr, tr.scratch->depth[l].data(), seg.t0, seg.t1, x, y, *path, cnt)
-                 : trace(tr.scratch->depth[l], seg.t0, s0, seg.t1);
+        h = !path ? trace(tr.scratch->depth[l], seg.t0, s0, seg.t1)
+            : pl.paths_inside
+                ? scanPathInside(tr, pl.depth, seg.t0, seg.t1, y * tr.width + x, *path, cnt)
+                : scanPath(tr, pl.depth, seg.t0, seg.t1, x, y, *path, cnt);
     }
     // A ray that crossed the whole segment without a hit still has a cone (missCone),
     // composited in depth order with the transparent plane.
@@ -245,7 +292,7 @@ void traceLayer(const Tracer& tr, uint32_t x, uint32_t y, uint32_t l, bool hitta
     // from its mipmap (§4.4).
     const float ta = std::max(s0, seg.own0);
     const float tb = std::min(h.hit ? h.t : seg.t1, seg.own1);
-    if (can_hit && seg.transparent && ta < tb) {
+    if (!kPlain && can_hit && seg.transparent && ta < tb) {
         const Hit ht = trace(tr.scratch->transparent_depth[l], seg.own0, ta, tb);
         if (ht.hit && miss && miss->t < ht.t)
             addMiss(); // the missed cone's content lies in front of the pane
@@ -324,7 +371,23 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
     const float t_last = tr.segs.back().t1;
     double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
     MultiviewRayRecord* records = debugRecords(tr, x, y);
-    for (uint32_t k = 0; k < tr.samples->size(); ++k) {
+    const uint32_t n = tr.samples->size();
+    // No ray is recorded or discarded (the usual case): the weighted mean alone, as below.
+    const bool plain = !records && s.offscreen != OffscreenPolicy::Discard;
+    for (uint32_t k = 0; plain && k < n; ++k) {
+        const RayState& ray = rays[k];
+        glm::vec3 color = ray.color;
+        if (ray.transmit > 0.0f) {
+            ++cnt.background;
+            color += ray.transmit * tr.background;
+        }
+        const double wt = double(ray.lens.weight);
+        sum_r += wt * double(color.r);
+        sum_g += wt * double(color.g);
+        sum_b += wt * double(color.b);
+        sum_w += wt;
+    }
+    for (uint32_t k = 0; !plain && k < n; ++k) {
         const RayState& ray = rays[k];
         if (ray.discarded)
             continue;
@@ -394,20 +457,26 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
             }
             beginRays(tr, x, y, rays + p * n, cnt);
         }
+    PixelLayer pxl;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
         const uint32_t l = tile_layers[i];
+        pxl.setLayer(tr, l);
         for (uint32_t y = y0; y < y1; ++y)
             for (uint32_t x = x0; x < x1; ++x) {
                 const size_t p = size_t(y - y0) * tw + (x - x0);
                 if (!((pixel_layers[p].active >> l) & 1))
                     continue;
-                const bool hittable = (pixel_layers[p].hittable >> l) & 1;
+                pxl.setPixel(tr, x, y, (pixel_layers[p].hittable >> l) & 1);
                 RayState* pr = rays + p * n;
                 MultiviewRayRecord* recs = debugRecords(tr, x, y);
+                const bool plain = !pxl.shade && !recs && !pxl.seg->transparent;
                 uint32_t live = 0;
                 for (uint32_t k = 0; k < n; ++k)
                     if (pr[k].transmit > 0.0f) {
-                        traceLayer(tr, x, y, l, hittable, k, pr[k], recs ? recs + k : nullptr, cnt);
+                        if (plain)
+                            traceLayer<true>(tr, pxl, k, pr[k], nullptr, cnt);
+                        else
+                            traceLayer<false>(tr, pxl, k, pr[k], recs ? recs + k : nullptr, cnt);
                         live += pr[k].transmit > 0.0f ? 1 : 0;
                     }
                 if (live == 0)

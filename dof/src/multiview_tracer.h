@@ -31,6 +31,11 @@ constexpr uint32_t kMaxMipLevels = 8;
 constexpr std::array<float, kMaxMipLevels> kMipScale = {1.0f,    0.5f,     0.25f,     0.125f,
                                                         0.0625f, 0.03125f, 0.015625f, 0.0078125f};
 
+// A path walked in advance is culled per ray only when longer than this: an N-buffer query
+// costs about as much as scanning that many cells (tracing time on demo, dense and foliage at
+// N = 64 with thresholds 0, 4, 8 and never: 8 and never were fastest, 0 slowest by 10-20 %).
+constexpr uint32_t kRayCullMinCells = 8;
+
 // The mip levels a trilinear lookup of a `diameter`-pixel window reads (§4.4): l0 and l1 = l0 + 1
 // (clamped to the top level), blended by f.
 struct MipLevel {
@@ -56,7 +61,8 @@ struct LayerSeg {
     // (MultiviewSettings::cone_misses); the lookup reads texels within cone_px of the ray's
     // position there (0: misses are not coned).
     float t_cone = 0.0f, cone_px = 0.0f;
-    MipLevel cone_level; // the levels of that first lookup (its diameter is lambda |C(t_cone)|)
+    float coc_cone = 0.0f; // C(t_cone): the same for every ray, so computed once
+    MipLevel cone_level;   // the levels of that first lookup (its diameter is lambda |C(t_cone)|)
     // Every ray's first lookup reads texels within first_cone_px of its pixel's centre: the ray
     // is within r_max |C(t_cone)| of it at t_cone, and a bilinear tap of level L within 1.5 2^L
     // of the ray (+1 for rounding).
@@ -71,6 +77,13 @@ struct LayerSeg {
     struct {
         int32_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
     } focus_box;
+    // With paths walked in advance: the union of every sample's path box in this segment
+    // (RayPath offsets; empty when x0 > x1), so one test per pixel tells whether all of its
+    // paths lie in the image, and whether any path is long enough to be culled per ray.
+    struct {
+        int32_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+    } paths_box;
+    bool long_paths = false; // some path has more than kRayCullMinCells cells
 };
 
 // One traced ray's result inside a layer.
@@ -108,6 +121,19 @@ struct TileCounters {
              transparent_hits = 0, layer_steps = 0, pixels_in_focus = 0;
 };
 
+// One lens ray between the layers of its pixel (traceTile traces a tile layer by layer, so each
+// ray's state waits here while the other rays of the tile meet the same layer).
+struct RayState {
+    LensSample lens;            // jittered lens position (§4.5) and weight
+    glm::vec2 w{0.0f};          // image offset per unit C (lensRayImageOffset)
+    glm::vec2 wc{0.0f};         // where its cones are centred, per unit C (ConeCentre)
+    glm::vec3 color{0.0f};      // what it has seen so far
+    float transmit = 1.0f;      // (1 - v1) products of partially covered cones (§4.4); 0: ended
+    float t_resume = -INFINITY; // where a continuation behind a partial cone starts (§4.4)
+    float t_end = 0.0f;
+    bool discarded = false; // its path starts outside the image (OffscreenPolicy::Discard)
+};
+
 // Everything the per-pixel loop reads; built once per frame.
 struct Tracer {
     const raster::View* view = nullptr;
@@ -131,6 +157,9 @@ struct Tracer {
     // ConeCentre::Cell: per sample, its cone centre's image offset per unit C relative to the
     // ray's (the cell offset with x negated, as lensRayImageOffset); empty: cones on the rays.
     std::vector<glm::vec2> cone_offsets;
+    // With the shared sample set (JitterMode::None): ray k's state before the first layer, the
+    // same for every pixel (beginRays copies it); empty otherwise.
+    std::vector<RayState> first_rays;
     // Per layer: its colour, owned and transparent mipmaps (MultiviewScratch), where built.
     std::vector<MipChain> mips, owned_mips, transparent_mips;
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
@@ -149,6 +178,7 @@ struct Tracer {
         keep(paths, fresh.paths);
         keep(cells, fresh.cells);
         keep(cone_offsets, fresh.cone_offsets);
+        keep(first_rays, fresh.first_rays);
         keep(mips, fresh.mips);
         keep(owned_mips, fresh.owned_mips);
         keep(transparent_mips, fresh.transparent_mips);
@@ -227,19 +257,6 @@ inline CellBox cellBox(glm::vec2 o0, glm::vec2 o1) {
     return {int64_t(std::floor(std::min(o0.x, o1.x))), int64_t(std::floor(std::max(o0.x, o1.x))),
             int64_t(std::floor(std::min(o0.y, o1.y))), int64_t(std::floor(std::max(o0.y, o1.y)))};
 }
-
-// One lens ray between the layers of its pixel (traceTile traces a tile layer by layer, so each
-// ray's state waits here while the other rays of the tile meet the same layer).
-struct RayState {
-    LensSample lens;            // jittered lens position (§4.5) and weight
-    glm::vec2 w{0.0f};          // image offset per unit C (lensRayImageOffset)
-    glm::vec2 wc{0.0f};         // where its cones are centred, per unit C (ConeCentre)
-    glm::vec3 color{0.0f};      // what it has seen so far
-    float transmit = 1.0f;      // (1 - v1) products of partially covered cones (§4.4); 0: ended
-    float t_resume = -INFINITY; // where a continuation behind a partial cone starts (§4.4)
-    float t_end = 0.0f;
-    bool discarded = false; // its path starts outside the image (OffscreenPolicy::Discard)
-};
 
 // The layers a pixel's rays can meet, as bit masks over layer indices.
 struct PixelLayers {

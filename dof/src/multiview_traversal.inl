@@ -148,28 +148,34 @@ Hit scanHeightField(const Tracer& tr, const float* depth, float seg_near, float 
     return hit;
 }
 
+// scanHeightField over a path walked in advance that lies in the image around pixel index
+// `pixel` (y * width + x): no texel is clamped or left out (scanCell's test on texels addressed
+// by their offsets).
+Hit scanPathInside(const Tracer& tr, const float* depth, float seg_near, float s1, uint32_t pixel,
+                   const RayPath& path, TileCounters& cnt) {
+    Hit hit;
+    const PathCell* cells = tr.cells.data() + path.first;
+    for (uint32_t i = 0; i < path.count; ++i) {
+        const PathCell& c = cells[i];
+        const uint32_t texel = uint32_t(int64_t(pixel) + c.offset);
+        if (cellHit(tr, depth[texel], seg_near, s1, c.t_in, c.t_out, texel, hit)) {
+            cnt.fetches += i + 1;
+            return hit;
+        }
+    }
+    cnt.fetches += path.count;
+    return hit;
+}
+
 // scanHeightField over a path walked in advance (the same cells, so the same result).
 Hit scanPath(const Tracer& tr, const float* depth, float seg_near, float s1, uint32_t x, uint32_t y,
              const RayPath& path, TileCounters& cnt) {
-    Hit hit;
-    const PathCell* cells = tr.cells.data() + path.first;
     if (int64_t(x) + path.box_x0 >= 0 && int64_t(y) + path.box_y0 >= 0 &&
         int64_t(x) + path.box_x1 < int64_t(tr.width) &&
-        int64_t(y) + path.box_y1 < int64_t(tr.height)) {
-        // The whole path lies in the image: no texel is clamped or left out (scanCell's test
-        // on texels addressed by their offsets).
-        const uint32_t pixel = y * tr.width + x;
-        for (uint32_t i = 0; i < path.count; ++i) {
-            const PathCell& c = cells[i];
-            const uint32_t texel = uint32_t(int64_t(pixel) + c.offset);
-            if (cellHit(tr, depth[texel], seg_near, s1, c.t_in, c.t_out, texel, hit)) {
-                cnt.fetches += i + 1;
-                return hit;
-            }
-        }
-        cnt.fetches += path.count;
-        return hit;
-    }
+        int64_t(y) + path.box_y1 < int64_t(tr.height))
+        return scanPathInside(tr, depth, seg_near, s1, y * tr.width + x, path, cnt);
+    Hit hit;
+    const PathCell* cells = tr.cells.data() + path.first;
     for (uint32_t i = 0; i < path.count; ++i) {
         const PathCell& c = cells[i];
         if (scanCell(tr, depth, seg_near, s1, x, y, c.dx, c.dy, c.t_in, c.t_out, cnt, hit))
