@@ -186,7 +186,18 @@ void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_hei
 } // namespace
 
 std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const LevelPlan& plan) {
-    std::vector<FragmentLevel> levels(plan.levels() + 1);
+    std::vector<FragmentLevel> levels;
+    planLevels(width, height, plan, levels);
+    return levels;
+}
+
+void planLevels(uint32_t width, uint32_t height, const LevelPlan& plan,
+                std::vector<FragmentLevel>& levels) {
+    // Every level starts as a default one; geometry holds no fragments, so this moves empty
+    // arrays and allocates nothing once `levels` has the capacity.
+    levels.resize(plan.levels() + 1);
+    for (FragmentLevel& l : levels)
+        l = FragmentLevel{};
     FragmentLevel& base = levels[0];
     base.index = 0;
     base.kind = LevelKind::Base;
@@ -225,7 +236,6 @@ std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const Lev
     for (FragmentLevel& l : levels)
         finishGeometry(l, width, height);
     levels[0].lookup_variance = 0.0; // pixel centres are the base cells' centres
-    return levels;
 }
 
 LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,

@@ -1,10 +1,10 @@
 // Allocations of a second identical frame of dof::FrameRenderer, per method (issue 20 part 4).
 // A program of its own: it replaces the global operator new, which would count every test of
 // the executable it is linked into. The counts are printed and recorded (RecordProperty). The
-// renderer, pinhole, accum, gather and multiview (the shared samples, Halton, noise and rotated
-// jitter, and other options) allocate nothing and are asserted to; multilayer's count and
-// multiview's with per-ray shading are not yet zero (issue 20 part 4's goal) and are only
-// printed.
+// renderer and every method (multiview with the shared samples, Halton, noise and rotated
+// jitter, per-ray shading and other options; multilayer with box or aperture levels, a
+// polygon aperture, level contributions and other options) allocate nothing, with or without a
+// report, and are asserted to; the second frame has the first one's bytes.
 //
 // The same program injects allocation failures (issue 20 part 4): the K-th allocation after
 // arming fails (operator new throws std::bad_alloc), for every K a first frame of each method
@@ -162,6 +162,13 @@ struct Case {
             dof::LensSampleSet::create({}, dof::LensPattern::Hammersley, 16, 0);
         FOCAL_CHECK(set.ok());
         samples = std::move(*set);
+        dof::ApertureShape pentagon;
+        pentagon.kind = dof::ApertureKind::Polygon;
+        pentagon.blades = 5;
+        pentagon.rotation_deg = 10.0f;
+        set = dof::LensSampleSet::create(pentagon, dof::LensPattern::Hammersley, 16, 0);
+        FOCAL_CHECK(set.ok());
+        polygon_samples = std::move(*set);
         dof::MultiviewSettings halton;
         halton.jitter = dof::JitterMode::Halton;
         methods = {{"pinhole", dof::PinholeMethod{}},
@@ -192,6 +199,34 @@ struct Case {
             m.precompute_paths = false;
         });
         variant("multiview_view_dependent", [](auto& m) { m.view_dependent = true; });
+        // Multilayer's options that change what a frame builds (counted, not fault-injected).
+        auto layered = [&](const char* name, const dof::LensSampleSet* lens_set, auto&& configure) {
+            dof::MultilayerSettings m;
+            configure(m);
+            variants.push_back({name, dof::MultilayerMethod{m, lens_set}});
+        };
+        layered("multilayer_no_samples", nullptr, [](auto&) {});
+        layered("multilayer_polygon", &polygon_samples, [](auto&) {});
+        layered("multilayer_box_over", &samples, [](auto& m) {
+            m.filter = dof::LevelFilter::Box;
+            m.blend = dof::LayerBlend::Over;
+        });
+        layered("multilayer_all_fragments_stack_3", &samples, [](auto& m) {
+            m.fragments_per_pixel = 0;
+            m.mip_levels = 2;
+            m.stack_levels = 3;
+        });
+        layered("multilayer_contributions_every_cell", &samples, [](auto& m) {
+            m.level_contributions = true;
+            m.skip_unread_cells = false;
+            m.truncate = false;
+            m.mean_depth = false;
+        });
+        layered("multilayer_float_no_skip_hidden", &samples, [](auto& m) {
+            m.color_format = raster::ColorFormat::Float32;
+            m.skip_hidden = false;
+            m.aperture_grids = {3, 4, 5};
+        });
         rgba.resize(size_t(view.width) * view.height * 4);
         depth.resize(size_t(view.width) * view.height);
         image = {rgba.data(), size_t(view.width) * 4, depth.data(), view.width};
@@ -214,6 +249,7 @@ struct Case {
     raster::View view;
     dof::ThinLens lens;
     dof::LensSampleSet samples;
+    dof::LensSampleSet polygon_samples; // a pentagon: multilayer's near and far levels differ
     std::vector<std::pair<std::string, dof::MethodSettings>> methods, variants;
     std::vector<float> rgba, depth;
     dof::FrameImage image;
@@ -251,15 +287,22 @@ TEST(FrameRendererAllocations, SecondIdenticalFramePerMethod) {
             dof::FrameRenderer frames(pool);
             dof::FrameReport report;
             ASSERT_TRUE(frames.render(*scene, view, lens, {}, method, image, &report).ok());
+            const uint64_t first_hash = setup.hash();
             raster::Status second;
             const Count c = counted(
                 [&] { second = frames.render(*scene, view, lens, {}, method, image, &report); });
             ASSERT_TRUE(second.ok()) << name << ": " << second.message();
-            // Not yet zero: multilayer, and multiview's per-ray shading (§5), whose
-            // raster::SurfaceShader is made per frame.
-            if (name != "multilayer" && name != "multiview_view_dependent") {
-                EXPECT_EQ(c.allocations, 0u) << name << ", " << threads << " threads";
-            }
+            EXPECT_EQ(c.allocations, 0u) << name << ", " << threads << " threads";
+            EXPECT_EQ(setup.hash(), first_hash) << name << ", " << threads << " threads";
+            // Without a report: the frame renderer keeps its own, so a second such frame
+            // allocates nothing either.
+            ASSERT_TRUE(frames.render(*scene, view, lens, {}, method, image).ok());
+            const Count no_report =
+                counted([&] { second = frames.render(*scene, view, lens, {}, method, image); });
+            ASSERT_TRUE(second.ok()) << name << ": " << second.message();
+            EXPECT_EQ(no_report.allocations, 0u)
+                << name << " without a report, " << threads << " threads";
+            EXPECT_EQ(setup.hash(), first_hash) << name << ", " << threads << " threads";
             std::printf("focal: second %s frame, %ux%u, %u threads: %llu allocations, %llu "
                         "bytes\n",
                         name.c_str(), view.width, view.height, threads,

@@ -214,6 +214,9 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
 // The geometry (size, spacing, origin, dilation, variances) of every level of `plan` over a
 // base of width x height, without building them.
 std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const LevelPlan& plan);
+// The same into `levels`, reusing its memory (what it held is replaced).
+void planLevels(uint32_t width, uint32_t height, const LevelPlan& plan,
+                std::vector<FragmentLevel>& levels);
 
 // Fills level `next` (geometry from planLevels) from `prev` (§5.1 mip or §5.2 stack step),
 // one task per row of cells, each cell merged in a fixed order: the bytes do not depend on the

@@ -196,6 +196,8 @@ private:
     std::optional<LensSampleSet> sequence_2n_; // multiview's §4.5 Halton set
     Multilayer multilayer_;
     MultilayerImage multilayer_image_;
+    MultilayerSettings multilayer_settings_; // the frame's, with what the frame renderer fills in
+    FrameReport report_;                     // the report of a render() call given none
 };
 
 } // namespace dof

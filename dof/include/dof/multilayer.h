@@ -193,6 +193,20 @@ public:
         uint32_t i1 = 0;
         float f = 0.0f;
     };
+    // The frame's plan: the geometry of the box hierarchy (§5) and of the aperture levels read
+    // from it, and T, the levels the traversal reads in order of their variance (§6.1). An
+    // implementation detail, public for the scratch below.
+    struct Plan {
+        LevelPlan plan;
+        std::vector<FragmentLevel> boxes;     // geometry of box levels 0..n
+        std::vector<FragmentLevel> apertures; // geometry of the aperture levels, in T order
+        struct Entry {
+            bool aperture = false;
+            uint32_t level = 0; // into boxes or apertures
+        };
+        std::vector<Entry> traversal; // T
+        std::vector<double> variance; // V_S of T
+    };
 
 private:
     raster::FragmentLists lists_;
@@ -207,7 +221,9 @@ private:
     std::vector<uint32_t> grid_sizes_;
     double grid_m2_ = 0.0;
     bool grid_asymmetric_ = false;
-    // Working memory kept between frames, so that a warm Multilayer allocates less.
+    // Working memory kept between frames, resized in place, so that a second frame of the same
+    // size and settings allocates nothing.
+    Plan plan_;
     std::vector<float> row_min_, row_max_;
     std::vector<std::vector<AxisTap>> tx_, ty_;
     std::vector<LevelBorders::Segment> segments_;
