@@ -1,3 +1,5 @@
+#include "out_of_memory.h"
+
 #include <dof/multilayer.h>
 #include <raster/check.h>
 
@@ -6,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <new>
 #include <string>
 
 namespace dof {
@@ -242,10 +245,20 @@ raster::Status validate(const MultilayerSettings& s) {
     return {};
 }
 
+raster::Status Multilayer::outOfMemory(const raster::View& view) noexcept {
+    // The kept buffers may be half resized: give them back (moves of empty buffers, which
+    // allocate nothing), so that the next frame starts as a first one does.
+    *this = Multilayer{};
+    return detail::outOfMemoryWhile([&] {
+        return "rendering multilayer at " + std::to_string(view.width) + "x" +
+               std::to_string(view.height);
+    });
+}
+
 raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens,
                                   glm::vec3 background, const MultilayerSettings& settings,
                                   const CollectFn& collect, raster::TaskPool& pool,
-                                  MultilayerImage& out, MultilayerStats* stats) {
+                                  MultilayerImage& out, MultilayerStats* stats) try {
     if (raster::Status s = validate(settings); !s.ok())
         return s;
     if (raster::Status s = validate(lens, view); !s.ok())
@@ -272,13 +285,15 @@ raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens
     if (s.ok() && stats)
         stats->ms_collect += ms_lists;
     return s;
+} catch (const std::bad_alloc&) {
+    return outOfMemory(view);
 }
 
 raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                                            const raster::View& view, const ThinLens& lens,
                                            glm::vec3 background, const MultilayerSettings& settings,
                                            raster::TaskPool& pool, MultilayerImage& out,
-                                           MultilayerStats* stats) {
+                                           MultilayerStats* stats) try {
     if (raster::Status s = validate(settings); !s.ok())
         return s;
     if (raster::Status s = validate(lens, view); !s.ok())
@@ -665,6 +680,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         }
     }
     return {};
+} catch (const std::bad_alloc&) {
+    return outOfMemory(view);
 }
 
 } // namespace dof

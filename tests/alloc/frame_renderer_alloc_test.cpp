@@ -374,6 +374,104 @@ TEST(FrameRendererAllocations, FailedAllocationIsAStatus) {
     }
 }
 
+// The same for dof::Multilayer::render called directly (no FrameRenderer around it), with the
+// renderer's fragment-list collection as its callback: from a fresh object, and from a warm one
+// that rendered a smaller frame before (its kept buffers are then resized part way when the
+// allocation fails). The frame ends in an out-of-memory Status, or succeeds with the clean bytes,
+// and the next frame on the same objects gives the clean bytes.
+TEST(FrameRendererAllocations, FailedAllocationInMultilayerRenderIsAStatus) {
+    const char* trials_env = std::getenv("FOCAL_FAULT_TRIALS");
+    const uint64_t max_trials = trials_env ? std::strtoull(trials_env, nullptr, 10) : 150;
+    Case c;
+    dof::MultilayerSettings settings;
+    settings.aperture = c.samples.shape();
+    settings.aperture_second_moment = dof::apertureSecondMoment(c.samples);
+    const raster::View small = raster::viewFromCamera(c.scene.cameras.at(0), 48, 32);
+    const dof::ThinLens small_lens =
+        dof::makeThinLens(small, c.lens.aperture_radius, c.lens.focus_distance);
+    // FNV-1a 64 over a multilayer image's colour and depth.
+    const auto hash = [](const dof::MultilayerImage& image) {
+        uint64_t h = 1469598103934665603ull;
+        for (const std::vector<float>* v : {&image.rgba, &image.depth}) {
+            const auto* bytes = reinterpret_cast<const unsigned char*>(v->data());
+            for (size_t i = 0; i < v->size() * sizeof(float); ++i)
+                h = (h ^ bytes[i]) * 1099511628211ull;
+        }
+        return h;
+    };
+    for (uint32_t threads : {0u, 2u}) {
+        raster::TaskPool pool(threads);
+        for (bool warm : {false, true}) {
+            const char* name = warm ? "warm" : "fresh";
+            // One renderer and one Multilayer per attempt, warmed on the small view.
+            struct Objects {
+                explicit Objects(raster::TaskPool& p) : renderer(p) {}
+                raster::Renderer renderer;
+                dof::Multilayer multilayer;
+                dof::MultilayerImage image;
+            };
+            const auto render = [&](Objects& o, const raster::View& view,
+                                    const dof::ThinLens& lens) {
+                const struct {
+                    raster::Renderer& renderer;
+                    const raster::Scene& scene;
+                    const raster::View& view;
+                } call{o.renderer, c.scene, view};
+                const dof::CollectFn collect = [&call](const raster::FragmentListDesc& desc,
+                                                       raster::FragmentLists& lists) {
+                    return call.renderer.renderFragmentLists(call.scene, call.view, {}, desc,
+                                                             lists);
+                };
+                return o.multilayer.render(view, lens, c.scene.background, settings, collect, pool,
+                                           o.image);
+            };
+            uint64_t clean = 0, first = 0;
+            {
+                Objects o(pool);
+                if (warm) {
+                    ASSERT_TRUE(render(o, small, small_lens).ok());
+                }
+                raster::Status s;
+                first = counted([&] { s = render(o, c.view, c.lens); }).allocations;
+                ASSERT_TRUE(s.ok()) << s.message();
+                clean = hash(o.image);
+            }
+            const uint64_t stride =
+                max_trials == 0 ? 1 : std::max<uint64_t>(1, (first + max_trials - 1) / max_trials);
+            uint64_t trials = 0, statuses = 0;
+            for (uint64_t k = 1; k <= first; k += stride, ++trials) {
+                Objects o(pool);
+                if (warm) {
+                    ASSERT_TRUE(render(o, small, small_lens).ok());
+                }
+                g_failed = false;
+                g_fail_countdown = int64_t(k);
+                const raster::Status s = render(o, c.view, c.lens);
+                g_fail_countdown = 0;
+                if (!s.ok()) {
+                    ++statuses;
+                    EXPECT_TRUE(g_failed) << name << ", allocation " << k << ": " << s.message();
+                    EXPECT_NE(s.message().find("out of memory"), std::string::npos)
+                        << name << ", allocation " << k << ": " << s.message();
+                } else {
+                    EXPECT_EQ(hash(o.image), clean) << name << ", allocation " << k << " failed";
+                }
+                const raster::Status again = render(o, c.view, c.lens);
+                ASSERT_TRUE(again.ok())
+                    << name << ", after allocation " << k << " failed: " << again.message();
+                EXPECT_EQ(hash(o.image), clean) << name << ", after allocation " << k << " failed";
+            }
+            std::printf("focal: Multilayer::render, %s, %u threads: a frame makes %llu "
+                        "allocations; %llu of them failed in turn (stride %llu), %llu ended in "
+                        "an out-of-memory Status\n",
+                        name, threads, static_cast<unsigned long long>(first),
+                        static_cast<unsigned long long>(trials),
+                        static_cast<unsigned long long>(stride),
+                        static_cast<unsigned long long>(statuses));
+        }
+    }
+}
+
 // The same for the lens resolution with autofocus on a focus pixel (FrameRenderer::resolveLens
 // renders the pinhole frame through FrameRenderer::pinhole).
 TEST(FrameRendererAllocations, FailedAllocationInResolveLensIsAStatus) {

@@ -11,6 +11,13 @@
 // Fragments are stored premultiplied: (α·c, α, d). The paper's merged colour c' is stored as α'c',
 // which makes the over operator and the additive combine of §5.1 plain sums (no 1/α').
 // Depth d is the distance along the view axis (raster::distanceFromDepth), float32.
+//
+// Memory: these are the stages dof::Multilayer runs. They fill containers the caller owns
+// (levels, border tables, merged lists), reusing their capacity, and return plain values: an
+// allocation that fails throws std::bad_alloc out of them, as from the std::vector they fill.
+// Their only failure is running out of memory, and a frame reaches them only through
+// Multilayer::render or renderFromLists, which turn it into a Status; a Status per stage would
+// only carry that same failure one stage further.
 #pragma once
 
 #include <dof/aperture_grid.h>

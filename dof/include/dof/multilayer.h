@@ -167,13 +167,17 @@ class Multilayer {
 public:
     // Renders one frame: collect, filter, accumulate. `background` is the colour behind every
     // fragment (raster::Scene::background). Fails on invalid settings or lens, or when the
-    // collection fails; `out` is then unchanged.
+    // collection fails; `out` is then unchanged. Running out of memory anywhere in the frame,
+    // on any thread of the pool, is a Status too ("out of memory while rendering multilayer at
+    // WxH", or the collection's own), never an exception: this object then releases its kept
+    // buffers, `out` may be partly written, and the next call renders as a first frame does.
     raster::Status render(const raster::View& view, const ThinLens& lens, glm::vec3 background,
                           const MultilayerSettings& settings, const CollectFn& collect,
                           raster::TaskPool& pool, MultilayerImage& out,
                           MultilayerStats* stats = nullptr);
 
-    // Runs §5 and §6 on lists collected elsewhere (stage-by-stage use and tests).
+    // Runs §5 and §6 on lists collected elsewhere (stage-by-stage use and tests). Fails as
+    // render() does, out of memory included.
     raster::Status renderFromLists(const raster::FragmentLists& lists, const raster::View& view,
                                    const ThinLens& lens, glm::vec3 background,
                                    const MultilayerSettings& settings, raster::TaskPool& pool,
@@ -209,6 +213,9 @@ public:
     };
 
 private:
+    // After std::bad_alloc: releases every kept buffer and returns the out-of-memory Status.
+    raster::Status outOfMemory(const raster::View& view) noexcept;
+
     raster::FragmentLists lists_;
     std::vector<FragmentLevel> levels_;
     std::vector<FragmentLevel> apertures_;
