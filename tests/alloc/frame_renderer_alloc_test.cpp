@@ -23,6 +23,7 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <new>
 #include <optional>
 #include <string>
@@ -315,73 +316,76 @@ TEST(FrameRendererAllocations, SecondIdenticalFramePerMethod) {
     }
 }
 
-// The K-th allocation of a first frame fails, for K = 1, 2, ... up to the allocations a clean
-// first frame makes (strided to at most 150 values of K per method, or FOCAL_FAULT_TRIALS; 0
-// tries every K): the frame returns
-// an out-of-memory Status, or succeeds with the clean frame's bytes when that allocation was not
-// needed after all; either way the next frame on the same object succeeds with the clean bytes.
-TEST(FrameRendererAllocations, FailedAllocationIsAStatus) {
+// The K-th allocation of a first frame fails, for K = 1, 2, ... up to the `first` allocations a
+// clean first frame makes (strided to at most 150 values of K, or FOCAL_FAULT_TRIALS; 0 tries
+// every K): the frame returns an out-of-memory Status, or succeeds with the clean frame's bytes
+// (`clean`) when that allocation was not needed after all; either way the next frame on the same
+// objects succeeds with the clean bytes. `make()` returns fresh objects (a std::unique_ptr) for
+// one attempt, `render(objects)` renders the frame and `hash(objects)` hashes what it wrote.
+template <class Make, class Render, class Hash>
+void failEachAllocation(const std::string& label, uint64_t first, uint64_t clean, Make&& make,
+                        Render&& render, Hash&& hash) {
     const char* trials_env = std::getenv("FOCAL_FAULT_TRIALS");
     const uint64_t max_trials = trials_env ? std::strtoull(trials_env, nullptr, 10) : 150;
+    const uint64_t stride =
+        max_trials == 0 ? 1 : std::max<uint64_t>(1, (first + max_trials - 1) / max_trials);
+    uint64_t trials = 0, statuses = 0;
+    for (uint64_t k = 1; k <= first; k += stride, ++trials) {
+        auto objects = make();
+        g_failed = false;
+        g_fail_countdown = int64_t(k);
+        const raster::Status s = render(*objects);
+        g_fail_countdown = 0;
+        if (!s.ok()) {
+            ++statuses;
+            EXPECT_TRUE(g_failed) << label << ", allocation " << k << ": " << s.message();
+            EXPECT_NE(s.message().find("out of memory"), std::string::npos)
+                << label << ", allocation " << k << ": " << s.message();
+        } else {
+            EXPECT_EQ(hash(*objects), clean) << label << ", allocation " << k << " failed";
+        }
+        const raster::Status again = render(*objects);
+        ASSERT_TRUE(again.ok()) << label << ", after allocation " << k
+                                << " failed: " << again.message();
+        EXPECT_EQ(hash(*objects), clean) << label << ", after allocation " << k << " failed";
+    }
+    std::printf("focal: %s: a first frame makes %llu allocations; %llu of them failed in turn "
+                "(stride %llu), %llu ended in an out-of-memory Status\n",
+                label.c_str(), static_cast<unsigned long long>(first),
+                static_cast<unsigned long long>(trials), static_cast<unsigned long long>(stride),
+                static_cast<unsigned long long>(statuses));
+}
+
+// failEachAllocation for a FrameRenderer's first frame, per method, at 0 and 2 threads.
+TEST(FrameRendererAllocations, FailedAllocationIsAStatus) {
     Case c;
     for (uint32_t threads : {0u, 2u}) {
         raster::TaskPool pool(threads);
         for (const auto& entry : c.methods) {
-            const std::string& name = entry.first;
             const dof::MethodSettings& method = entry.second;
-            uint64_t clean = 0, first = 0;
+            const auto make = [&] { return std::make_unique<dof::FrameRenderer>(pool); };
+            const auto render = [&](dof::FrameRenderer& frames) {
+                return frames.render(c.scene, c.view, c.lens, {}, method, c.image);
+            };
+            const auto hash = [&](const dof::FrameRenderer&) { return c.hash(); };
+            uint64_t first = 0;
             {
-                dof::FrameRenderer frames(pool);
+                const auto frames = make();
                 raster::Status s;
-                first = counted([&] {
-                            s = frames.render(c.scene, c.view, c.lens, {}, method, c.image);
-                        }).allocations;
-                ASSERT_TRUE(s.ok()) << name << ": " << s.message();
-                clean = c.hash();
+                first = counted([&] { s = render(*frames); }).allocations;
+                ASSERT_TRUE(s.ok()) << entry.first << ": " << s.message();
             }
-            const uint64_t stride =
-                max_trials == 0 ? 1 : std::max<uint64_t>(1, (first + max_trials - 1) / max_trials);
-            uint64_t trials = 0, statuses = 0;
-            for (uint64_t k = 1; k <= first; k += stride, ++trials) {
-                dof::FrameRenderer frames(pool);
-                g_failed = false;
-                g_fail_countdown = int64_t(k);
-                const raster::Status s =
-                    frames.render(c.scene, c.view, c.lens, {}, method, c.image);
-                g_fail_countdown = 0;
-                if (!s.ok()) {
-                    ++statuses;
-                    EXPECT_TRUE(g_failed) << name << ", allocation " << k << ": " << s.message();
-                    EXPECT_NE(s.message().find("out of memory"), std::string::npos)
-                        << name << ", allocation " << k << ": " << s.message();
-                } else {
-                    EXPECT_EQ(c.hash(), clean) << name << ", allocation " << k << " failed";
-                }
-                const raster::Status again =
-                    frames.render(c.scene, c.view, c.lens, {}, method, c.image);
-                ASSERT_TRUE(again.ok())
-                    << name << ", after allocation " << k << " failed: " << again.message();
-                EXPECT_EQ(c.hash(), clean) << name << ", after allocation " << k << " failed";
-            }
-            std::printf("focal: %s, %u threads: a first frame makes %llu allocations; %llu of "
-                        "them failed in turn (stride %llu), %llu ended in an out-of-memory "
-                        "Status\n",
-                        name.c_str(), threads, static_cast<unsigned long long>(first),
-                        static_cast<unsigned long long>(trials),
-                        static_cast<unsigned long long>(stride),
-                        static_cast<unsigned long long>(statuses));
+            failEachAllocation(entry.first + ", " + std::to_string(threads) + " threads", first,
+                               c.hash(), make, render, hash);
         }
     }
 }
 
-// The same for dof::Multilayer::render called directly (no FrameRenderer around it), with the
-// renderer's fragment-list collection as its callback: from a fresh object, and from a warm one
-// that rendered a smaller frame before (its kept buffers are then resized part way when the
-// allocation fails). The frame ends in an out-of-memory Status, or succeeds with the clean bytes,
-// and the next frame on the same objects gives the clean bytes.
+// failEachAllocation for dof::Multilayer::render called directly (no FrameRenderer around it),
+// with the renderer's fragment-list collection as its callback: on a fresh object, and on a
+// warm one that rendered a smaller frame before (its kept buffers are then resized part way
+// when the allocation fails).
 TEST(FrameRendererAllocations, FailedAllocationInMultilayerRenderIsAStatus) {
-    const char* trials_env = std::getenv("FOCAL_FAULT_TRIALS");
-    const uint64_t max_trials = trials_env ? std::strtoull(trials_env, nullptr, 10) : 150;
     Case c;
     dof::MultilayerSettings settings;
     settings.aperture = c.samples.shape();
@@ -389,85 +393,57 @@ TEST(FrameRendererAllocations, FailedAllocationInMultilayerRenderIsAStatus) {
     const raster::View small = raster::viewFromCamera(c.scene.cameras.at(0), 48, 32);
     const dof::ThinLens small_lens =
         dof::makeThinLens(small, c.lens.aperture_radius, c.lens.focus_distance);
-    // FNV-1a 64 over a multilayer image's colour and depth.
-    const auto hash = [](const dof::MultilayerImage& image) {
-        uint64_t h = 1469598103934665603ull;
-        for (const std::vector<float>* v : {&image.rgba, &image.depth}) {
-            const auto* bytes = reinterpret_cast<const unsigned char*>(v->data());
-            for (size_t i = 0; i < v->size() * sizeof(float); ++i)
-                h = (h ^ bytes[i]) * 1099511628211ull;
-        }
-        return h;
-    };
     for (uint32_t threads : {0u, 2u}) {
         raster::TaskPool pool(threads);
-        for (bool warm : {false, true}) {
-            const char* name = warm ? "warm" : "fresh";
-            // One renderer and one Multilayer per attempt, warmed on the small view.
-            struct Objects {
-                explicit Objects(raster::TaskPool& p) : renderer(p) {}
-                raster::Renderer renderer;
-                dof::Multilayer multilayer;
-                dof::MultilayerImage image;
-            };
-            const auto render = [&](Objects& o, const raster::View& view,
+        struct Objects {
+            explicit Objects(raster::TaskPool& p) : renderer(p) {}
+            raster::Renderer renderer;
+            dof::Multilayer multilayer;
+            dof::MultilayerImage image;
+        };
+        const auto renderView = [&](Objects& o, const raster::View& view,
                                     const dof::ThinLens& lens) {
-                const struct {
-                    raster::Renderer& renderer;
-                    const raster::Scene& scene;
-                    const raster::View& view;
-                } call{o.renderer, c.scene, view};
-                const dof::CollectFn collect = [&call](const raster::FragmentListDesc& desc,
-                                                       raster::FragmentLists& lists) {
-                    return call.renderer.renderFragmentLists(call.scene, call.view, {}, desc,
-                                                             lists);
-                };
-                return o.multilayer.render(view, lens, c.scene.background, settings, collect, pool,
-                                           o.image);
+            const struct {
+                raster::Renderer& renderer;
+                const raster::Scene& scene;
+                const raster::View& view;
+            } call{o.renderer, c.scene, view};
+            const dof::CollectFn collect = [&call](const raster::FragmentListDesc& desc,
+                                                   raster::FragmentLists& lists) {
+                return call.renderer.renderFragmentLists(call.scene, call.view, {}, desc, lists);
             };
-            uint64_t clean = 0, first = 0;
+            return o.multilayer.render(view, lens, c.scene.background, settings, collect, pool,
+                                       o.image);
+        };
+        const auto render = [&](Objects& o) { return renderView(o, c.view, c.lens); };
+        // FNV-1a 64 over the image's colour and depth.
+        const auto hash = [](const Objects& o) {
+            uint64_t h = 1469598103934665603ull;
+            for (const std::vector<float>* v : {&o.image.rgba, &o.image.depth}) {
+                const auto* bytes = reinterpret_cast<const unsigned char*>(v->data());
+                for (size_t i = 0; i < v->size() * sizeof(float); ++i)
+                    h = (h ^ bytes[i]) * 1099511628211ull;
+            }
+            return h;
+        };
+        for (bool warm : {false, true}) {
+            const auto make = [&] {
+                auto o = std::make_unique<Objects>(pool);
+                if (warm)
+                    FOCAL_CHECK(renderView(*o, small, small_lens).ok());
+                return o;
+            };
+            uint64_t first = 0, clean = 0;
             {
-                Objects o(pool);
-                if (warm) {
-                    ASSERT_TRUE(render(o, small, small_lens).ok());
-                }
+                const auto o = make();
                 raster::Status s;
-                first = counted([&] { s = render(o, c.view, c.lens); }).allocations;
+                first = counted([&] { s = render(*o); }).allocations;
                 ASSERT_TRUE(s.ok()) << s.message();
-                clean = hash(o.image);
+                clean = hash(*o);
             }
-            const uint64_t stride =
-                max_trials == 0 ? 1 : std::max<uint64_t>(1, (first + max_trials - 1) / max_trials);
-            uint64_t trials = 0, statuses = 0;
-            for (uint64_t k = 1; k <= first; k += stride, ++trials) {
-                Objects o(pool);
-                if (warm) {
-                    ASSERT_TRUE(render(o, small, small_lens).ok());
-                }
-                g_failed = false;
-                g_fail_countdown = int64_t(k);
-                const raster::Status s = render(o, c.view, c.lens);
-                g_fail_countdown = 0;
-                if (!s.ok()) {
-                    ++statuses;
-                    EXPECT_TRUE(g_failed) << name << ", allocation " << k << ": " << s.message();
-                    EXPECT_NE(s.message().find("out of memory"), std::string::npos)
-                        << name << ", allocation " << k << ": " << s.message();
-                } else {
-                    EXPECT_EQ(hash(o.image), clean) << name << ", allocation " << k << " failed";
-                }
-                const raster::Status again = render(o, c.view, c.lens);
-                ASSERT_TRUE(again.ok())
-                    << name << ", after allocation " << k << " failed: " << again.message();
-                EXPECT_EQ(hash(o.image), clean) << name << ", after allocation " << k << " failed";
-            }
-            std::printf("focal: Multilayer::render, %s, %u threads: a frame makes %llu "
-                        "allocations; %llu of them failed in turn (stride %llu), %llu ended in "
-                        "an out-of-memory Status\n",
-                        name, threads, static_cast<unsigned long long>(first),
-                        static_cast<unsigned long long>(trials),
-                        static_cast<unsigned long long>(stride),
-                        static_cast<unsigned long long>(statuses));
+            failEachAllocation(std::string("Multilayer::render, ") + (warm ? "warm" : "fresh") +
+                                   ", " + std::to_string(threads) + " threads",
+                               first, clean, make, render, hash);
         }
     }
 }
