@@ -1,7 +1,10 @@
+#include "out_of_memory.h"
+
 #include <dof/aperture_grid.h>
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 
 namespace dof {
 
@@ -11,15 +14,17 @@ raster::Result<LensSampleSet> apertureGridSamples(const ApertureShape& shape) {
 }
 
 raster::Result<ApertureGrid> apertureGrid(const ApertureShape& shape, uint32_t size,
-                                          FocalSide side) {
+                                          FocalSide side) try {
     raster::Result<LensSampleSet> set = apertureGridSamples(shape);
     if (!set.ok())
-        return set.status();
+        return set.status(); // a copy of its message, which may allocate
     return apertureGrid(*set, shape, size, side);
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("building an aperture grid");
 }
 
 raster::Result<ApertureGrid> apertureGrid(const LensSampleSet& samples, const ApertureShape& shape,
-                                          uint32_t size, FocalSide side) {
+                                          uint32_t size, FocalSide side) try {
     if (size == 0 || size > 64)
         return raster::Status::error("aperture grid: the cell count per axis must be in [1, 64]");
     ApertureGrid grid;
@@ -55,6 +60,8 @@ raster::Result<ApertureGrid> apertureGrid(const LensSampleSet& samples, const Ap
     }
     grid.second_moment = m2 / total;
     return grid;
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("building an aperture grid");
 }
 
 bool sameWeights(const ApertureGrid& a, const ApertureGrid& b) {

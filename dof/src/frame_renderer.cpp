@@ -225,6 +225,7 @@ void FrameRenderer::releaseAfterFailure(const MethodSettings& method) noexcept {
         multilayer_ = Multilayer{};
         multilayer_image_ = MultilayerImage{};
     }
+    report_ = FrameReport{};
 }
 
 raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const raster::View& view,
@@ -235,8 +236,8 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
     // The pinhole made by pinhole() serves this frame only.
     const bool kept = pinhole_kept_;
     pinhole_kept_ = false;
-    FrameReport local_report;
-    FrameReport& report = report_out ? *report_out : local_report;
+    // Without a caller's report, the kept one (its stage list and statistics keep their memory).
+    FrameReport& report = report_out ? *report_out : report_;
     // Cleared field by field: a caller's report keeps its capacity from frame to frame.
     report.stage_ms.clear();
     report.render_sum = {};
@@ -410,17 +411,30 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
     }
 
     const MultilayerMethod& m = std::get<MultilayerMethod>(method);
-    MultilayerSettings settings = m.settings;
+    // Copied into the kept settings, whose arrays (aperture grids, mask) keep their memory.
+    MultilayerSettings& settings = multilayer_settings_;
+    settings = m.settings;
     settings.memory_budget = options.memory_budget;
     if (m.samples) {
         settings.aperture = m.samples->shape();
         settings.aperture_second_moment = apertureSecondMoment(*m.samples);
     }
-    const CollectFn collect = [&](const raster::FragmentListDesc& desc,
-                                  raster::FragmentLists& lists) {
-        return renderer_->renderFragmentLists(scene, pin, options, desc, lists, &report.collect);
+    // The callback captures two pointers, which std::function stores without allocating.
+    const struct {
+        const raster::Scene& scene;
+        const raster::View& view;
+        const raster::RenderOptions& options;
+        raster::FrameStats& stats;
+    } call{scene, pin, options, report.collect};
+    const CollectFn collect = [this, &call](const raster::FragmentListDesc& desc,
+                                            raster::FragmentLists& lists) {
+        return renderer_->renderFragmentLists(call.scene, call.view, call.options, desc, lists,
+                                              &call.stats);
     };
-    MultilayerStats st;
+    // The statistics go straight into the report's, whose arrays keep their memory.
+    if (!std::holds_alternative<MultilayerStats>(report.method_stats))
+        report.method_stats.emplace<MultilayerStats>();
+    MultilayerStats& st = std::get<MultilayerStats>(report.method_stats);
     if (Status s = multilayer_.render(pin, lens, scene.background, settings, collect, pool_,
                                       multilayer_image_, &st);
         !s.ok())
@@ -433,7 +447,6 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                         size_t(view.width) * sizeof(float));
     report.stage_ms = {
         {"collect", st.ms_collect}, {"filter", st.ms_filter}, {"accumulate", st.ms_accumulate}};
-    report.method_stats = std::move(st);
     return {};
 }
 

@@ -1,3 +1,5 @@
+#include "out_of_memory.h"
+
 #include <dof/multilayer.h>
 #include <raster/check.h>
 
@@ -6,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <new>
 #include <string>
 
 namespace dof {
@@ -80,20 +83,12 @@ TapRows tapRows(const FragmentLevel& level, const AxisTap& ay) {
 
 constexpr float kOpaque = 1.0f - 1.0f / 1024.0f; // stop once the pixel is this opaque
 
-// The frame's plan: the box hierarchy (§5), the aperture levels read from it, and T, the
-// levels the traversal reads in order of their variance (§6.1).
-struct Plan {
-    LevelPlan plan;
-    std::vector<FragmentLevel> boxes;     // geometry of box levels 0..n
-    std::vector<FragmentLevel> apertures; // geometry of the aperture levels, in T order
-    struct Entry {
-        bool aperture = false;
-        uint32_t level = 0; // into boxes or apertures
-    };
-    std::vector<Entry> traversal; // T
-    std::vector<double> variance; // V_S of T
-    double radius(size_t s, double m2) const { return std::sqrt(variance[s] / m2); }
-};
+using Plan = Multilayer::Plan;
+
+// r_S of level s of T: the |C| whose aperture variance m2·C² is the level's (§6.1).
+double radius(const Plan& p, size_t s, double m2) {
+    return std::sqrt(p.variance[s] / m2);
+}
 
 // The planned levels hold up to N fragments per cell (N = fragments_per_pixel, 16 when all are
 // kept): an estimate of what filtering them takes, checked before any level is allocated.
@@ -134,7 +129,7 @@ void planTraversal(Plan& p, uint32_t width, uint32_t height, const MultilayerSet
     p.variance.push_back(p.boxes[0].variance());
     for (const FragmentLevel& box : p.boxes)
         for (const ApertureGrid& grid : grids) {
-            if (p.radius(p.variance.size() - 1, m2) >= double(max_coc_px))
+            if (radius(p, p.variance.size() - 1, m2) >= double(max_coc_px))
                 return;
             FragmentLevel a =
                 planApertureLevel(box, grid, uint32_t(p.traversal.size()), width, height);
@@ -146,27 +141,28 @@ void planTraversal(Plan& p, uint32_t width, uint32_t height, const MultilayerSet
         }
 }
 
-Plan makePlan(uint32_t width, uint32_t height, const MultilayerSettings& settings,
-              const std::vector<ApertureGrid>& grids, double m2, float max_coc_px) {
-    Plan p;
+// The frame's plan into `p`, reusing its memory.
+void makePlan(uint32_t width, uint32_t height, const MultilayerSettings& settings,
+              const std::vector<ApertureGrid>& grids, double m2, float max_coc_px, Plan& p) {
+    p.plan = LevelPlan{};
     p.plan.mip_steps = settings.mip_levels;
     p.plan.epsilon = settings.epsilon;
     p.plan.truncate = settings.truncate;
     p.plan.mean_depth = settings.mean_depth;
     if (settings.stack_levels >= 0) {
         p.plan.stack_steps = uint32_t(settings.stack_levels);
-        p.boxes = planLevels(width, height, p.plan);
+        planLevels(width, height, p.plan, p.boxes);
         planTraversal(p, width, height, settings, grids, m2, max_coc_px);
-        return p;
+        return;
     }
     // Auto: the fewest stack steps whose top level of T matches the largest |C| in the frame.
     for (uint32_t stack = 0;; ++stack) {
         p.plan.stack_steps = stack;
-        p.boxes = planLevels(width, height, p.plan);
+        planLevels(width, height, p.plan, p.boxes);
         planTraversal(p, width, height, settings, grids, m2, max_coc_px);
-        if (p.radius(p.variance.size() - 1, m2) >= double(max_coc_px) ||
+        if (radius(p, p.variance.size() - 1, m2) >= double(max_coc_px) ||
             p.plan.levels() >= kMaxFilterLevels)
-            return p;
+            return;
     }
 }
 
@@ -212,10 +208,20 @@ MultilayerLevelStats levelStats(const FragmentLevel& l) {
 
 } // namespace
 
+raster::Status Multilayer::outOfMemory(const raster::View& view) noexcept {
+    // The kept buffers may be half resized: give them back (moves of empty buffers, which
+    // allocate nothing), so that the next frame starts as a first one does.
+    *this = Multilayer{};
+    return detail::outOfMemoryWhile([&] {
+        return "rendering multilayer at " + std::to_string(view.width) + "x" +
+               std::to_string(view.height);
+    });
+}
+
 raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens,
                                   glm::vec3 background, const MultilayerSettings& settings,
                                   const CollectFn& collect, raster::TaskPool& pool,
-                                  MultilayerImage& out, MultilayerStats* stats) {
+                                  MultilayerImage& out, MultilayerStats* stats) try {
     if (raster::Status s = validate(settings); !s.ok())
         return s;
     if (raster::Status s = validate(lens, view); !s.ok())
@@ -242,13 +248,15 @@ raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens
     if (s.ok() && stats)
         stats->ms_collect += ms_lists;
     return s;
+} catch (const std::bad_alloc&) {
+    return outOfMemory(view);
 }
 
 raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                                            const raster::View& view, const ThinLens& lens,
                                            glm::vec3 background, const MultilayerSettings& settings,
                                            raster::TaskPool& pool, MultilayerImage& out,
-                                           MultilayerStats* stats) {
+                                           MultilayerStats* stats) try {
     if (raster::Status s = validate(settings); !s.ok())
         return s;
     if (raster::Status s = validate(lens, view); !s.ok())
@@ -328,7 +336,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     }
 
     // §5: plan the Y-map and T, compute the border table (§6.1).
-    Plan plan = makePlan(width, height, settings, grids[0], m2, max_coc);
+    Plan& plan = plan_;
+    makePlan(width, height, settings, grids[0], m2, max_coc, plan);
     if (raster::Status s = checkLevelMemory(plan, settings, max_coc); !s.ok())
         return s;
     levelBorders(lens, plan.variance, m2, borders_);
@@ -421,9 +430,13 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     out.rgba.assign(size_t(width) * height * 4, 0.0f);
     out.depth.assign(size_t(width) * height, std::numeric_limits<float>::infinity());
     const bool contributions = settings.level_contributions;
-    out.level_rgba.clear();
-    if (contributions)
-        out.level_rgba.assign(n + 2, std::vector<float>(size_t(width) * height * 4, 0.0f));
+    if (contributions) {
+        out.level_rgba.resize(n + 2);
+        for (std::vector<float>& level : out.level_rgba)
+            level.assign(size_t(width) * height * 4, 0.0f);
+    } else {
+        out.level_rgba.clear();
+    }
     const float scale = 1.0f + settings.epsilon;
     // Slices join the group of the previous one while within this factor of its depth.
     const float group_scale =
@@ -630,6 +643,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         }
     }
     return {};
+} catch (const std::bad_alloc&) {
+    return outOfMemory(view);
 }
 
 } // namespace dof

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -39,65 +38,6 @@ void sumRows(const std::vector<uint32_t>& longest, const std::vector<uint64_t>& 
     }
 }
 
-// mergeLists for the taps of one cell, all with the same `pieces` and no empty list: list k
-// runs from next[k] to end[k] with weight[k], k in list order, m <= 64. The live lists are a
-// bit mask instead of mergeLists' index array and the within-list share is specialised at
-// compile time; the windows, the lists visited, the operations and their order are
-// mergeLists', hence the same bytes.
-template <bool kPieces, class Keep>
-void mergeTaps(const LayerFragment** next, const LayerFragment* const* end, const float* weight,
-               uint32_t m, float scale, bool mean_depth, Keep&& keep,
-               std::vector<LayerFragment>& out, uint64_t& dropped) {
-    static_assert(kMaxMergeLists <= 64);
-    uint64_t live = m >= 64 ? ~uint64_t{0} : (uint64_t{1} << m) - 1;
-    while (live != 0) {
-        // Closest head over all lists, in list order (a value: ties do not matter).
-        float d0 = next[std::countr_zero(live)]->depth;
-        for (uint64_t bits = live & (live - 1); bits != 0; bits &= bits - 1)
-            d0 = std::min(d0, next[std::countr_zero(bits)]->depth);
-        const float limit = d0 * scale;
-        LayerFragment merged;
-        float depth_sum = 0.0f;
-        for (uint64_t bits = live; bits != 0; bits &= bits - 1) {
-            const int k = std::countr_zero(bits);
-            const LayerFragment* f = next[k];
-            if (!(f->depth <= limit))
-                continue;
-            // Within list k, front to back (§5.1, first case). A list of one fragment (the
-            // common case) takes its first step only, with pa = 0.
-            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
-            if (end[k] - f == 1) {
-                const float t = shareInList(*f, kPieces, 0.0f);
-                pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
-                pd += t * f->a * f->depth;
-                live &= ~(uint64_t{1} << k);
-            } else {
-                do {
-                    const float t = shareInList(*f, kPieces, pa);
-                    pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
-                    pd += t * f->a * f->depth;
-                    ++f;
-                } while (f != end[k] && f->depth <= limit);
-                next[k] = f;
-                if (f == end[k])
-                    live &= ~(uint64_t{1} << k);
-            }
-            // Additive blending across lists (§5.1, second case), weighted.
-            const float w = weight[k];
-            merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
-            depth_sum += w * pd;
-        }
-        if (!(merged.a > 0.0f))
-            continue;
-        merged.depth = mean_depth ? std::clamp(depth_sum / merged.a, d0, limit) : d0;
-        if (!keep(merged.depth)) {
-            ++dropped;
-            continue;
-        }
-        out.push_back(merged);
-    }
-}
-
 // The taps of one cell, in merge order, empty lists left out (they would add w·0 = +0 to sums
 // that start at +0 and so are never -0: the same bytes).
 struct CellTaps {
@@ -110,15 +50,15 @@ struct CellTaps {
         next[m] = f, end[m] = f + count, weight[m] = w;
         ++m;
     }
-    // Appends the §5.1 merge of the taps (mergeTaps) and consumes them.
+    // Appends the §5.1 merge of the taps (mergeListArrays) and consumes them.
     template <class Keep>
     void merge(const LevelPlan& plan, bool pieces, Keep&& keep, std::vector<LayerFragment>& out,
                uint64_t& dropped) {
-        const float scale = 1.0f + plan.epsilon;
+        const float e = plan.epsilon;
         if (pieces)
-            mergeTaps<true>(next, end, weight, m, scale, plan.mean_depth, keep, out, dropped);
+            mergeListArrays<true>(next, end, weight, m, e, plan.mean_depth, keep, out, dropped);
         else
-            mergeTaps<false>(next, end, weight, m, scale, plan.mean_depth, keep, out, dropped);
+            mergeListArrays<false>(next, end, weight, m, e, plan.mean_depth, keep, out, dropped);
     }
 };
 
@@ -186,7 +126,18 @@ void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_hei
 } // namespace
 
 std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const LevelPlan& plan) {
-    std::vector<FragmentLevel> levels(plan.levels() + 1);
+    std::vector<FragmentLevel> levels;
+    planLevels(width, height, plan, levels);
+    return levels;
+}
+
+void planLevels(uint32_t width, uint32_t height, const LevelPlan& plan,
+                std::vector<FragmentLevel>& levels) {
+    // Every level starts as a default one; geometry holds no fragments, so this moves empty
+    // arrays and allocates nothing once `levels` has the capacity.
+    levels.resize(plan.levels() + 1);
+    for (FragmentLevel& l : levels)
+        l = FragmentLevel{};
     FragmentLevel& base = levels[0];
     base.index = 0;
     base.kind = LevelKind::Base;
@@ -225,7 +176,6 @@ std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const Lev
     for (FragmentLevel& l : levels)
         finishGeometry(l, width, height);
     levels[0].lookup_variance = 0.0; // pixel centres are the base cells' centres
-    return levels;
 }
 
 LevelBorders levelBorders(const ThinLens& lens, const std::vector<double>& level_variance,

@@ -126,10 +126,10 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     tr.width = width;
     tr.height = height;
     tr.background = background;
-    std::optional<raster::SurfaceShader> shader;
     if (shade) {
-        shader.emplace(*shading.scene, view, shading.simd);
-        tr.shader = &*shader;
+        // Kept with the frame state: preparing it again reuses its memory.
+        fs.shader.prepare(*shading.scene, view, shading.simd);
+        tr.shader = &fs.shader;
     }
     // C as an affine function of stored depth D: 1/d = 1/f - D (1/n - 1/f) (camera.h), so
     // C = E f_px (1/d_f - 1/f) + E f_px (1/n - 1/f) D (Eq. 3).

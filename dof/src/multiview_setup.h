@@ -45,6 +45,7 @@ struct FrameState {
     std::vector<TileCounters> counters;    // per output tile
     std::vector<RayState> ray_states;      // per worker: one tile's rays
     std::vector<PixelLayers> pixel_layers; // per worker: one tile's pixels
+    raster::SurfaceShader shader;          // per-ray shading (§5), prepared again each frame
 };
 
 // Per-layer float depths (empty -> kEmptyDepth) into scratch.depth and transparent_depth, and

@@ -33,6 +33,9 @@ struct Renderer::State {
     std::vector<std::vector<FragmentNode>> list_kept;
     // ListSink early rejection: per worker, the k nearest depths of each pixel of its tile.
     std::vector<std::vector<float>> list_nearest;
+    // The resolve's counts per tile: the longest list appended and the fragments hidden.
+    std::vector<uint32_t> list_longest;
+    std::vector<uint64_t> list_hidden;
     // Layered rendering: the overlapped interval of each layer.
     std::vector<LayerInterval> layer_intervals;
 };
@@ -373,7 +376,13 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                                                    : desc.max_per_pixel;
     if (st.sort_scratch.size() < pool_.workerCount())
         st.sort_scratch.resize(pool_.workerCount());
+    // Every worker's early-rejection keys are sized here, not by the first tile it happens to
+    // take: which worker takes which tile varies, and a second identical frame allocates nothing.
     st.list_nearest.resize(pool_.workerCount());
+    const size_t nearest_size =
+        size_t(st.ctx.grid.tile_size) * st.ctx.grid.tile_size * size_t(early_k);
+    for (std::vector<float>& nearest : st.list_nearest)
+        nearest.reserve(nearest_size);
 
     // Collection: every fragment, in primitive order, into its tile's pool.
     auto t0 = std::chrono::steady_clock::now();
@@ -383,8 +392,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         if (early_k > 0) {
             const TileRect r = tileRect(st.ctx.grid, tile);
             std::vector<float>& nearest = st.list_nearest[worker];
-            nearest.assign(size_t(st.ctx.grid.tile_size) * st.ctx.grid.tile_size * early_k,
-                           INFINITY);
+            nearest.assign(nearest_size, INFINITY);
             sink.nearest = nearest.data();
             sink.k = early_k;
             sink.cap = desc.max_per_pixel;
@@ -399,11 +407,24 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     uint64_t collected = 0;
     for (const std::vector<FragmentNode>& p : st.list_pools)
         collected += p.size();
-    out = FragmentLists{};
+    // Reset field by field: the arrays are emptied but keep their memory for the next frame.
+    out.offsets.clear();
+    out.list_length.clear();
+    out.primitive.clear();
+    out.color.half.clear();
+    out.color.float32.clear();
+    out.depth.unorm16.clear();
+    out.depth.float32.clear();
+    out.depth.width = out.depth.height = 0;
     out.width = view.width;
     out.height = view.height;
     out.desc = desc;
     out.fragments_collected = collected;
+    out.fragments_rejected = 0;
+    out.fragments_hidden = 0;
+    out.fragments_kept = 0;
+    out.max_list_length = 0;
+    out.grew = false;
     for (const TileCounters& c : st.tile_counters)
         out.fragments_rejected += c.rejected;
     out.node_capacity_used = desc.node_capacity;
@@ -435,8 +456,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     out.offsets.assign(pixels + 1, 0);
     out.list_length.assign(pixels, 0);
     st.list_kept.resize(tiles);
-    std::vector<uint32_t> longest(tiles, 0);
-    std::vector<uint64_t> hidden(tiles, 0);
+    std::vector<uint32_t>& longest = st.list_longest;
+    std::vector<uint64_t>& hidden = st.list_hidden;
+    longest.assign(tiles, 0);
+    hidden.assign(tiles, 0);
     pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
         const TileRect r = tileRect(st.ctx.grid, tile);
         const std::vector<FragmentNode>& nodes = st.list_pools[tile];
@@ -485,6 +508,9 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         out.max_list_length = std::max(out.max_list_length, longest[t]);
         out.fragments_hidden += hidden[t];
     }
+    // Every worker's sort scratch holds the longest list, whichever tiles it sorts next time.
+    for (std::vector<FragmentNode>& list : st.sort_scratch)
+        list.reserve(out.max_list_length);
     const uint32_t total = out.offsets[pixels];
     out.fragments_kept = total;
     out.color.resize(desc.color_format, total, glm::vec4(0.0f));

@@ -18,8 +18,15 @@ struct SurfaceShader::Impl {
     ShadeContext ctx;
 };
 
-SurfaceShader::SurfaceShader(const Scene& scene, const View& view, bool simd)
-    : impl_(std::make_unique<Impl>()) {
+SurfaceShader::SurfaceShader() noexcept = default;
+
+SurfaceShader::SurfaceShader(const Scene& scene, const View& view, bool simd) {
+    prepare(scene, view, simd);
+}
+
+void SurfaceShader::prepare(const Scene& scene, const View& view, bool simd) {
+    if (!impl_)
+        impl_ = std::make_unique<Impl>();
     prepareLights(scene, defaultLightDirection(view), impl_->lights);
     impl_->ctx.scene = &scene;
     impl_->ctx.lights = impl_->lights.data();

@@ -1,10 +1,10 @@
 // Allocations of a second identical frame of dof::FrameRenderer, per method (issue 20 part 4).
 // A program of its own: it replaces the global operator new, which would count every test of
 // the executable it is linked into. The counts are printed and recorded (RecordProperty). The
-// renderer, pinhole, accum, gather and multiview (the shared samples, Halton, noise and rotated
-// jitter, and other options) allocate nothing and are asserted to; multilayer's count and
-// multiview's with per-ray shading are not yet zero (issue 20 part 4's goal) and are only
-// printed.
+// renderer and every method (multiview with the shared samples, Halton, noise and rotated
+// jitter, per-ray shading and other options; multilayer with box or aperture levels, a
+// polygon aperture, level contributions and other options) allocate nothing, with or without a
+// report, and are asserted to; the second frame has the first one's bytes.
 //
 // The same program injects allocation failures (issue 20 part 4): the K-th allocation after
 // arming fails (operator new throws std::bad_alloc), for every K a first frame of each method
@@ -23,6 +23,7 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <new>
 #include <optional>
 #include <string>
@@ -162,6 +163,13 @@ struct Case {
             dof::LensSampleSet::create({}, dof::LensPattern::Hammersley, 16, 0);
         FOCAL_CHECK(set.ok());
         samples = std::move(*set);
+        dof::ApertureShape pentagon;
+        pentagon.kind = dof::ApertureKind::Polygon;
+        pentagon.blades = 5;
+        pentagon.rotation_deg = 10.0f;
+        set = dof::LensSampleSet::create(pentagon, dof::LensPattern::Hammersley, 16, 0);
+        FOCAL_CHECK(set.ok());
+        polygon_samples = std::move(*set);
         dof::MultiviewSettings halton;
         halton.jitter = dof::JitterMode::Halton;
         methods = {{"pinhole", dof::PinholeMethod{}},
@@ -192,6 +200,34 @@ struct Case {
             m.precompute_paths = false;
         });
         variant("multiview_view_dependent", [](auto& m) { m.view_dependent = true; });
+        // Multilayer's options that change what a frame builds (counted, not fault-injected).
+        auto layered = [&](const char* name, const dof::LensSampleSet* lens_set, auto&& configure) {
+            dof::MultilayerSettings m;
+            configure(m);
+            variants.push_back({name, dof::MultilayerMethod{m, lens_set}});
+        };
+        layered("multilayer_no_samples", nullptr, [](auto&) {});
+        layered("multilayer_polygon", &polygon_samples, [](auto&) {});
+        layered("multilayer_box_over", &samples, [](auto& m) {
+            m.filter = dof::LevelFilter::Box;
+            m.blend = dof::LayerBlend::Over;
+        });
+        layered("multilayer_all_fragments_stack_3", &samples, [](auto& m) {
+            m.fragments_per_pixel = 0;
+            m.mip_levels = 2;
+            m.stack_levels = 3;
+        });
+        layered("multilayer_contributions_every_cell", &samples, [](auto& m) {
+            m.level_contributions = true;
+            m.skip_unread_cells = false;
+            m.truncate = false;
+            m.mean_depth = false;
+        });
+        layered("multilayer_float_no_skip_hidden", &samples, [](auto& m) {
+            m.color_format = raster::ColorFormat::Float32;
+            m.skip_hidden = false;
+            m.aperture_grids = {3, 4, 5};
+        });
         rgba.resize(size_t(view.width) * view.height * 4);
         depth.resize(size_t(view.width) * view.height);
         image = {rgba.data(), size_t(view.width) * 4, depth.data(), view.width};
@@ -214,6 +250,7 @@ struct Case {
     raster::View view;
     dof::ThinLens lens;
     dof::LensSampleSet samples;
+    dof::LensSampleSet polygon_samples; // a pentagon: multilayer's near and far levels differ
     std::vector<std::pair<std::string, dof::MethodSettings>> methods, variants;
     std::vector<float> rgba, depth;
     dof::FrameImage image;
@@ -251,15 +288,22 @@ TEST(FrameRendererAllocations, SecondIdenticalFramePerMethod) {
             dof::FrameRenderer frames(pool);
             dof::FrameReport report;
             ASSERT_TRUE(frames.render(*scene, view, lens, {}, method, image, &report).ok());
+            const uint64_t first_hash = setup.hash();
             raster::Status second;
             const Count c = counted(
                 [&] { second = frames.render(*scene, view, lens, {}, method, image, &report); });
             ASSERT_TRUE(second.ok()) << name << ": " << second.message();
-            // Not yet zero: multilayer, and multiview's per-ray shading (§5), whose
-            // raster::SurfaceShader is made per frame.
-            if (name != "multilayer" && name != "multiview_view_dependent") {
-                EXPECT_EQ(c.allocations, 0u) << name << ", " << threads << " threads";
-            }
+            EXPECT_EQ(c.allocations, 0u) << name << ", " << threads << " threads";
+            EXPECT_EQ(setup.hash(), first_hash) << name << ", " << threads << " threads";
+            // Without a report: the frame renderer keeps its own, so a second such frame
+            // allocates nothing either.
+            ASSERT_TRUE(frames.render(*scene, view, lens, {}, method, image).ok());
+            const Count no_report =
+                counted([&] { second = frames.render(*scene, view, lens, {}, method, image); });
+            ASSERT_TRUE(second.ok()) << name << ": " << second.message();
+            EXPECT_EQ(no_report.allocations, 0u)
+                << name << " without a report, " << threads << " threads";
+            EXPECT_EQ(setup.hash(), first_hash) << name << ", " << threads << " threads";
             std::printf("focal: second %s frame, %ux%u, %u threads: %llu allocations, %llu "
                         "bytes\n",
                         name.c_str(), view.width, view.height, threads,
@@ -272,61 +316,134 @@ TEST(FrameRendererAllocations, SecondIdenticalFramePerMethod) {
     }
 }
 
-// The K-th allocation of a first frame fails, for K = 1, 2, ... up to the allocations a clean
-// first frame makes (strided to at most 150 values of K per method, or FOCAL_FAULT_TRIALS; 0
-// tries every K): the frame returns
-// an out-of-memory Status, or succeeds with the clean frame's bytes when that allocation was not
-// needed after all; either way the next frame on the same object succeeds with the clean bytes.
-TEST(FrameRendererAllocations, FailedAllocationIsAStatus) {
+// The K-th allocation of a first frame fails, for K = 1, 2, ... up to the `first` allocations a
+// clean first frame makes (strided to at most 150 values of K, or FOCAL_FAULT_TRIALS; 0 tries
+// every K): the frame returns an out-of-memory Status, or succeeds with the clean frame's bytes
+// (`clean`) when that allocation was not needed after all; either way the next frame on the same
+// objects succeeds with the clean bytes. `make()` returns fresh objects (a std::unique_ptr) for
+// one attempt, `render(objects)` renders the frame and `hash(objects)` hashes what it wrote.
+template <class Make, class Render, class Hash>
+void failEachAllocation(const std::string& label, uint64_t first, uint64_t clean, Make&& make,
+                        Render&& render, Hash&& hash) {
     const char* trials_env = std::getenv("FOCAL_FAULT_TRIALS");
     const uint64_t max_trials = trials_env ? std::strtoull(trials_env, nullptr, 10) : 150;
+    const uint64_t stride =
+        max_trials == 0 ? 1 : std::max<uint64_t>(1, (first + max_trials - 1) / max_trials);
+    uint64_t trials = 0, statuses = 0;
+    for (uint64_t k = 1; k <= first; k += stride, ++trials) {
+        auto objects = make();
+        g_failed = false;
+        g_fail_countdown = int64_t(k);
+        const raster::Status s = render(*objects);
+        g_fail_countdown = 0;
+        if (!s.ok()) {
+            ++statuses;
+            EXPECT_TRUE(g_failed) << label << ", allocation " << k << ": " << s.message();
+            EXPECT_NE(s.message().find("out of memory"), std::string::npos)
+                << label << ", allocation " << k << ": " << s.message();
+        } else {
+            EXPECT_EQ(hash(*objects), clean) << label << ", allocation " << k << " failed";
+        }
+        const raster::Status again = render(*objects);
+        ASSERT_TRUE(again.ok()) << label << ", after allocation " << k
+                                << " failed: " << again.message();
+        EXPECT_EQ(hash(*objects), clean) << label << ", after allocation " << k << " failed";
+    }
+    std::printf("focal: %s: a first frame makes %llu allocations; %llu of them failed in turn "
+                "(stride %llu), %llu ended in an out-of-memory Status\n",
+                label.c_str(), static_cast<unsigned long long>(first),
+                static_cast<unsigned long long>(trials), static_cast<unsigned long long>(stride),
+                static_cast<unsigned long long>(statuses));
+}
+
+// failEachAllocation for a FrameRenderer's first frame, per method, at 0 and 2 threads.
+TEST(FrameRendererAllocations, FailedAllocationIsAStatus) {
     Case c;
     for (uint32_t threads : {0u, 2u}) {
         raster::TaskPool pool(threads);
         for (const auto& entry : c.methods) {
-            const std::string& name = entry.first;
             const dof::MethodSettings& method = entry.second;
-            uint64_t clean = 0, first = 0;
+            const auto make = [&] { return std::make_unique<dof::FrameRenderer>(pool); };
+            const auto render = [&](dof::FrameRenderer& frames) {
+                return frames.render(c.scene, c.view, c.lens, {}, method, c.image);
+            };
+            const auto hash = [&](const dof::FrameRenderer&) { return c.hash(); };
+            uint64_t first = 0;
             {
-                dof::FrameRenderer frames(pool);
+                const auto frames = make();
                 raster::Status s;
-                first = counted([&] {
-                            s = frames.render(c.scene, c.view, c.lens, {}, method, c.image);
-                        }).allocations;
-                ASSERT_TRUE(s.ok()) << name << ": " << s.message();
-                clean = c.hash();
+                first = counted([&] { s = render(*frames); }).allocations;
+                ASSERT_TRUE(s.ok()) << entry.first << ": " << s.message();
             }
-            const uint64_t stride =
-                max_trials == 0 ? 1 : std::max<uint64_t>(1, (first + max_trials - 1) / max_trials);
-            uint64_t trials = 0, statuses = 0;
-            for (uint64_t k = 1; k <= first; k += stride, ++trials) {
-                dof::FrameRenderer frames(pool);
-                g_failed = false;
-                g_fail_countdown = int64_t(k);
-                const raster::Status s =
-                    frames.render(c.scene, c.view, c.lens, {}, method, c.image);
-                g_fail_countdown = 0;
-                if (!s.ok()) {
-                    ++statuses;
-                    EXPECT_TRUE(g_failed) << name << ", allocation " << k << ": " << s.message();
-                    EXPECT_NE(s.message().find("out of memory"), std::string::npos)
-                        << name << ", allocation " << k << ": " << s.message();
-                } else {
-                    EXPECT_EQ(c.hash(), clean) << name << ", allocation " << k << " failed";
-                }
-                const raster::Status again =
-                    frames.render(c.scene, c.view, c.lens, {}, method, c.image);
-                ASSERT_TRUE(again.ok())
-                    << name << ", after allocation " << k << " failed: " << again.message();
-                EXPECT_EQ(c.hash(), clean) << name << ", after allocation " << k << " failed";
+            failEachAllocation(entry.first + ", " + std::to_string(threads) + " threads", first,
+                               c.hash(), make, render, hash);
+        }
+    }
+}
+
+// failEachAllocation for dof::Multilayer::render called directly (no FrameRenderer around it),
+// with the renderer's fragment-list collection as its callback: on a fresh object, and on a
+// warm one that rendered a smaller frame before (its kept buffers are then resized part way
+// when the allocation fails).
+TEST(FrameRendererAllocations, FailedAllocationInMultilayerRenderIsAStatus) {
+    Case c;
+    dof::MultilayerSettings settings;
+    settings.aperture = c.samples.shape();
+    settings.aperture_second_moment = dof::apertureSecondMoment(c.samples);
+    const raster::View small = raster::viewFromCamera(c.scene.cameras.at(0), 48, 32);
+    const dof::ThinLens small_lens =
+        dof::makeThinLens(small, c.lens.aperture_radius, c.lens.focus_distance);
+    for (uint32_t threads : {0u, 2u}) {
+        raster::TaskPool pool(threads);
+        struct Objects {
+            explicit Objects(raster::TaskPool& p) : renderer(p) {}
+            raster::Renderer renderer;
+            dof::Multilayer multilayer;
+            dof::MultilayerImage image;
+        };
+        const auto renderView = [&](Objects& o, const raster::View& view,
+                                    const dof::ThinLens& lens) {
+            const struct {
+                raster::Renderer& renderer;
+                const raster::Scene& scene;
+                const raster::View& view;
+            } call{o.renderer, c.scene, view};
+            const dof::CollectFn collect = [&call](const raster::FragmentListDesc& desc,
+                                                   raster::FragmentLists& lists) {
+                return call.renderer.renderFragmentLists(call.scene, call.view, {}, desc, lists);
+            };
+            return o.multilayer.render(view, lens, c.scene.background, settings, collect, pool,
+                                       o.image);
+        };
+        const auto render = [&](Objects& o) { return renderView(o, c.view, c.lens); };
+        // FNV-1a 64 over the image's colour and depth.
+        const auto hash = [](const Objects& o) {
+            uint64_t h = 1469598103934665603ull;
+            for (const std::vector<float>* v : {&o.image.rgba, &o.image.depth}) {
+                const auto* bytes = reinterpret_cast<const unsigned char*>(v->data());
+                for (size_t i = 0; i < v->size() * sizeof(float); ++i)
+                    h = (h ^ bytes[i]) * 1099511628211ull;
             }
-            std::printf("focal: %s, %u threads: a first frame makes %llu allocations; %llu of "
-                        "them failed in turn (stride %llu), %llu ended in an out-of-memory "
-                        "Status\n",
-                        name.c_str(), threads, static_cast<unsigned long long>(first),
-                        static_cast<unsigned long long>(trials),
-                        static_cast<unsigned long long>(stride),
-                        static_cast<unsigned long long>(statuses));
+            return h;
+        };
+        for (bool warm : {false, true}) {
+            const auto make = [&] {
+                auto o = std::make_unique<Objects>(pool);
+                if (warm)
+                    FOCAL_CHECK(renderView(*o, small, small_lens).ok());
+                return o;
+            };
+            uint64_t first = 0, clean = 0;
+            {
+                const auto o = make();
+                raster::Status s;
+                first = counted([&] { s = render(*o); }).allocations;
+                ASSERT_TRUE(s.ok()) << s.message();
+                clean = hash(*o);
+            }
+            failEachAllocation(std::string("Multilayer::render, ") + (warm ? "warm" : "fresh") +
+                                   ", " + std::to_string(threads) + " threads",
+                               first, clean, make, render, hash);
         }
     }
 }

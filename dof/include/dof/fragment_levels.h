@@ -11,6 +11,13 @@
 // Fragments are stored premultiplied: (α·c, α, d). The paper's merged colour c' is stored as α'c',
 // which makes the over operator and the additive combine of §5.1 plain sums (no 1/α').
 // Depth d is the distance along the view axis (raster::distanceFromDepth), float32.
+//
+// Memory: these are the stages dof::Multilayer runs. They fill containers the caller owns
+// (levels, border tables, merged lists), reusing their capacity, and return plain values: an
+// allocation that fails throws std::bad_alloc out of them, as from the std::vector they fill.
+// Their only failure is running out of memory, and a frame reaches them only through
+// Multilayer::render or renderFromLists, which turn it into a Status; a Status per stage would
+// only carry that same failure one stage further.
 #pragma once
 
 #include <dof/aperture_grid.h>
@@ -22,6 +29,7 @@
 #include <raster/task_pool.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -195,7 +203,9 @@ inline float shareInList(const LayerFragment& f, bool pieces, float pa) {
 // emit (Σ w α'c', Σ w α', depth) with depth d0 or, with mean_depth, the mean depth of what was
 // merged weighted by its visible opacity (in [d0, d0·(1 + ε)], so the output stays sorted);
 // repeat. Merged fragments with zero opacity are not emitted.
-// `keep(depth)` may drop a merged fragment (§6.2). Appends to `out`.
+// `keep(depth)` may drop a merged fragment (§6.2). Appends to `out`. The lists of one merge are
+// all of one kind (`pieces`, as the cells of one level are); mixing them is a contract
+// violation (FOCAL_CHECK).
 struct ListRef {
     const LayerFragment* data = nullptr;
     uint32_t count = 0;
@@ -206,6 +216,16 @@ template <class Keep>
 void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
                 Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped);
 
+// mergeLists on lists given as arrays, the form the level stages hold a cell's taps in: list k
+// runs from next[k] (advanced past what is merged) to end[k] with weight[k], k < m <=
+// kMaxMergeLists, none of them empty, all pieces or all not (kPieces). mergeLists runs this
+// after leaving out its empty lists (they would add w·0 = +0 to sums that start at +0 and so are
+// never -0: the same bytes), so the unit tests of mergeLists test what the render runs.
+template <bool kPieces, class Keep>
+void mergeListArrays(const LayerFragment** next, const LayerFragment* const* end,
+                     const float* weight, uint32_t m, float epsilon, bool mean_depth, Keep&& keep,
+                     std::vector<LayerFragment>& out, uint64_t& dropped);
+
 // Level 0 from the collected lists: premultiplies colour by opacity and converts stored depth D
 // to view distance. Fragments with zero opacity are dropped.
 void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
@@ -214,6 +234,9 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
 // The geometry (size, spacing, origin, dilation, variances) of every level of `plan` over a
 // base of width x height, without building them.
 std::vector<FragmentLevel> planLevels(uint32_t width, uint32_t height, const LevelPlan& plan);
+// The same into `levels`, reusing its memory (what it held is replaced).
+void planLevels(uint32_t width, uint32_t height, const LevelPlan& plan,
+                std::vector<FragmentLevel>& levels);
 
 // Fills level `next` (geometry from planLevels) from `prev` (§5.1 mip or §5.2 stack step),
 // one task per row of cells, each cell merged in a fixed order: the bytes do not depend on the
@@ -257,54 +280,54 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
 
 // ---------------------------------------------------------------------------------------------
 
-template <class Keep>
-void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
-                Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped) {
-    FOCAL_CHECK(list_count <= kMaxMergeLists);
-    // The lists that still hold fragments, in list order, and their next fragment. Only the
-    // lists with a fragment in a merge window are visited: another would add w·0 = +0 to sums
-    // that start at +0 and so are never -0, which leaves them unchanged (the same bytes).
-    uint8_t live[kMaxMergeLists];
-    const LayerFragment* next[kMaxMergeLists];
-    uint32_t live_count = 0;
-    for (uint32_t k = 0; k < list_count; ++k)
-        if (lists[k].count > 0) {
-            next[k] = lists[k].data;
-            live[live_count++] = uint8_t(k);
-        }
+template <bool kPieces, class Keep>
+void mergeListArrays(const LayerFragment** next, const LayerFragment* const* end,
+                     const float* weight, uint32_t m, float epsilon, bool mean_depth, Keep&& keep,
+                     std::vector<LayerFragment>& out, uint64_t& dropped) {
+    static_assert(kMaxMergeLists <= 64);
+    FOCAL_CHECK(m <= kMaxMergeLists);
     const float scale = 1.0f + epsilon;
-    while (live_count > 0) {
-        // Closest head over all lists (a value: ties do not matter).
-        float d0 = next[live[0]]->depth;
-        for (uint32_t m = 1; m < live_count; ++m)
-            d0 = std::min(d0, next[live[m]]->depth);
+    // The lists that still hold fragments, as a bit mask in list order. Only the lists with a
+    // fragment in a merge window are blended: another would add w·0 = +0 to sums that start at
+    // +0 and so are never -0, which leaves them unchanged (the same bytes).
+    uint64_t live = m >= 64 ? ~uint64_t{0} : (uint64_t{1} << m) - 1;
+    while (live != 0) {
+        // Closest head over all lists, in list order (a value: ties do not matter).
+        float d0 = next[std::countr_zero(live)]->depth;
+        for (uint64_t bits = live & (live - 1); bits != 0; bits &= bits - 1)
+            d0 = std::min(d0, next[std::countr_zero(bits)]->depth);
         const float limit = d0 * scale;
         LayerFragment merged;
         float depth_sum = 0.0f; // Σ w·(visible opacity)·depth, for the mean depth
-        uint32_t kept = 0;
-        for (uint32_t m = 0; m < live_count; ++m) {
-            const uint32_t k = live[m];
+        for (uint64_t bits = live; bits != 0; bits &= bits - 1) {
+            const int k = std::countr_zero(bits);
             const LayerFragment* f = next[k];
-            const LayerFragment* end = lists[k].data + lists[k].count;
-            if (f->depth <= limit) {
-                // Within list k, front to back (§5.1, first case).
-                float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
+            if (!(f->depth <= limit))
+                continue;
+            // Within list k, front to back (§5.1, first case). A list of one fragment (the
+            // common case) takes its first step only, with pa = 0.
+            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
+            if (end[k] - f == 1) {
+                const float t = shareInList(*f, kPieces, 0.0f);
+                pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
+                pd += t * f->a * f->depth;
+                live &= ~(uint64_t{1} << k);
+            } else {
                 do {
-                    const float t = shareInList(*f, lists[k].pieces, pa);
+                    const float t = shareInList(*f, kPieces, pa);
                     pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
                     pd += t * f->a * f->depth;
                     ++f;
-                } while (f != end && f->depth <= limit);
+                } while (f != end[k] && f->depth <= limit);
                 next[k] = f;
-                // Additive blending across lists (§5.1, second case), weighted.
-                const float w = lists[k].weight;
-                merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
-                depth_sum += w * pd;
+                if (f == end[k])
+                    live &= ~(uint64_t{1} << k);
             }
-            if (f != end)
-                live[kept++] = uint8_t(k);
+            // Additive blending across lists (§5.1, second case), weighted.
+            const float w = weight[k];
+            merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
+            depth_sum += w * pd;
         }
-        live_count = kept;
         if (!(merged.a > 0.0f))
             continue;
         merged.depth = mean_depth ? std::clamp(depth_sum / merged.a, d0, limit) : d0;
@@ -314,6 +337,32 @@ void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool m
         }
         out.push_back(merged);
     }
+}
+
+template <class Keep>
+void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
+                Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped) {
+    FOCAL_CHECK(list_count <= kMaxMergeLists);
+    // The non-empty lists, in list order.
+    const LayerFragment* next[kMaxMergeLists];
+    const LayerFragment* end[kMaxMergeLists];
+    float weight[kMaxMergeLists];
+    uint32_t m = 0;
+    bool pieces = false;
+    for (uint32_t k = 0; k < list_count; ++k) {
+        if (lists[k].count == 0)
+            continue;
+        FOCAL_CHECK(m == 0 || lists[k].pieces == pieces);
+        pieces = lists[k].pieces;
+        next[m] = lists[k].data;
+        end[m] = lists[k].data + lists[k].count;
+        weight[m] = lists[k].weight;
+        ++m;
+    }
+    if (pieces)
+        mergeListArrays<true>(next, end, weight, m, epsilon, mean_depth, keep, out, dropped);
+    else
+        mergeListArrays<false>(next, end, weight, m, epsilon, mean_depth, keep, out, dropped);
 }
 
 } // namespace dof

@@ -114,6 +114,9 @@ struct FrameReport {
 class FrameRenderer {
 public:
     // Renders with the caller's pool (which must outlive this object); threads == 0 runs inline.
+    // Allocates the renderer and its (empty) state; every frame buffer waits for the first
+    // frame. A constructor has no Status to return, so a failure there is std::bad_alloc, as
+    // from any standard container.
     explicit FrameRenderer(raster::TaskPool& pool);
     ~FrameRenderer();
     FrameRenderer(const FrameRenderer&) = delete;
@@ -196,6 +199,8 @@ private:
     std::optional<LensSampleSet> sequence_2n_; // multiview's §4.5 Halton set
     Multilayer multilayer_;
     MultilayerImage multilayer_image_;
+    MultilayerSettings multilayer_settings_; // the frame's, with what the frame renderer fills in
+    FrameReport report_;                     // the report of a render() call given none
 };
 
 } // namespace dof

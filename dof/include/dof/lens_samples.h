@@ -67,7 +67,9 @@ float hashToUnit(uint32_t h);
 // Per-pixel Cranley-Patterson rotation in [0,1)^2: a pure function of (x, y, seed).
 glm::vec2 pixelRotation(uint32_t x, uint32_t y, uint32_t seed);
 // `count` points of the pattern in [0,1)^2, index order; seed != 0 rotates the whole set by a
-// Cranley-Patterson shift and (Poisson) changes its candidates.
+// Cranley-Patterson shift and (Poisson) changes its candidates. Allocates the returned vector
+// (std::bad_alloc when that fails, as from the vector); LensSampleSet::create is the entry point
+// that returns a Status.
 std::vector<glm::vec2> primaryPoints(LensPattern pattern, uint32_t count, uint32_t seed);
 
 // Maps [0,1)^2 onto an aperture shape. Immutable after create(); cheap to copy.

@@ -55,12 +55,15 @@ uint64_t countDifferingPixels(const ImageRef& a, const ImageRef& b, float tolera
 // differs by more than `relative_jump` times the smaller of the two (infinite or non-positive
 // depth, i.e. background, differs from any finite depth). The band is every pixel within
 // Euclidean distance `radius_px` of an edge pixel (both sides of the edge). `depth` holds one
-// distance per pixel (channel 0 of `depth` is used).
+// distance per pixel (channel 0 of `depth` is used). Allocates the returned mask and its work
+// arrays: std::bad_alloc when that fails, as from the vector (a helper for comparisons and
+// benchmarks; no frame calls it).
 std::vector<uint8_t> discontinuityBand(const ImageRef& depth, float relative_jump, float radius_px);
 
 // False-colour difference: per pixel the largest |a - b| over RGB of sRGB-encoded values,
 // divided by `scale` and clamped, through a black-blue-magenta-orange-yellow ramp. Returns RGB
-// floats (width*height*3, linear values for an EXR or PNG writer).
+// floats (width*height*3, linear values for an EXR or PNG writer). Allocates the returned
+// image: std::bad_alloc when that fails, as from the vector (no frame calls it).
 std::vector<float> falseColorDifference(const ImageRef& a, const ImageRef& b, float scale);
 
 // sRGB transfer function (IEC 61966-2-1) for values in [0,1].

@@ -175,13 +175,17 @@ class Multilayer {
 public:
     // Renders one frame: collect, filter, accumulate. `background` is the colour behind every
     // fragment (raster::Scene::background). Fails on invalid settings or lens, or when the
-    // collection fails; `out` is then unchanged.
+    // collection fails; `out` is then unchanged. Running out of memory anywhere in the frame,
+    // on any thread of the pool, is a Status too ("out of memory while rendering multilayer at
+    // WxH", or the collection's own), never an exception: this object then releases its kept
+    // buffers, `out` may be partly written, and the next call renders as a first frame does.
     raster::Status render(const raster::View& view, const ThinLens& lens, glm::vec3 background,
                           const MultilayerSettings& settings, const CollectFn& collect,
                           raster::TaskPool& pool, MultilayerImage& out,
                           MultilayerStats* stats = nullptr);
 
-    // Runs §5 and §6 on lists collected elsewhere (stage-by-stage use and tests).
+    // Runs §5 and §6 on lists collected elsewhere (stage-by-stage use and tests). Fails as
+    // render() does, out of memory included.
     raster::Status renderFromLists(const raster::FragmentLists& lists, const raster::View& view,
                                    const ThinLens& lens, glm::vec3 background,
                                    const MultilayerSettings& settings, raster::TaskPool& pool,
@@ -201,8 +205,25 @@ public:
         uint32_t i1 = 0;
         float f = 0.0f;
     };
+    // The frame's plan: the geometry of the box hierarchy (§5) and of the aperture levels read
+    // from it, and T, the levels the traversal reads in order of their variance (§6.1). An
+    // implementation detail, public for the scratch below.
+    struct Plan {
+        LevelPlan plan;
+        std::vector<FragmentLevel> boxes;     // geometry of box levels 0..n
+        std::vector<FragmentLevel> apertures; // geometry of the aperture levels, in T order
+        struct Entry {
+            bool aperture = false;
+            uint32_t level = 0; // into boxes or apertures
+        };
+        std::vector<Entry> traversal; // T
+        std::vector<double> variance; // V_S of T
+    };
 
 private:
+    // After std::bad_alloc: releases every kept buffer and returns the out-of-memory Status.
+    raster::Status outOfMemory(const raster::View& view) noexcept;
+
     raster::FragmentLists lists_;
     std::vector<FragmentLevel> levels_;
     std::vector<FragmentLevel> apertures_;
@@ -215,7 +236,9 @@ private:
     std::vector<uint32_t> grid_sizes_;
     double grid_m2_ = 0.0;
     bool grid_asymmetric_ = false;
-    // Working memory kept between frames, so that a warm Multilayer allocates less.
+    // Working memory kept between frames, resized in place, so that a second frame of the same
+    // size and settings allocates nothing.
+    Plan plan_;
     std::vector<float> row_min_, row_max_;
     std::vector<std::vector<AxisTap>> tx_, ty_;
     std::vector<LevelBorders::Segment> segments_;

@@ -241,6 +241,8 @@ raster::Result<raster::LayeredTargetDesc> multiviewLayerDesc(const ThinLens& len
                                                              LayerSpacing* spacing_out = nullptr);
 
 // Mean distance from each sample to its nearest neighbour in lens units: the lambda of §4.4.
+// Allocates a search grid (std::bad_alloc when that fails; renderMultiview turns it into a
+// Status).
 float meanNeighbourDistance(const LensSampleSet& samples);
 
 // For each lens sample, the centroid of its Voronoi cell within the aperture minus the sample,
@@ -249,7 +251,8 @@ float meanNeighbourDistance(const LensSampleSet& samples);
 // to its nearest sample (ties: the lower index) and the centroid is the weighted mean of a
 // sample's points (a sample without points keeps offset 0). Empty when that leaves fewer than
 // 16 points a sample (more than 4096 samples by default): the cells are not measured, and the
-// cones stay on the rays.
+// cones stay on the rays. Allocates the returned offsets and the measuring set: std::bad_alloc
+// when that fails, never an empty result (renderMultiview turns it into a Status).
 std::vector<glm::vec2> lensCellOffsets(const LensSampleSet& samples, uint32_t fine_per_sample = 64);
 
 // The view-dependent shading context (§5): the scene whose lights shade each hit with the

@@ -27,7 +27,8 @@ struct NBuffer {
 
 // Builds levels 0..max_level (level n from level n-1 with four lookups, Décoret 2005 §3).
 // `depth` holds width*height values, row-major. `max_level` is clamped to what the image size
-// needs (2^n >= max(width, height) covers everything).
+// needs (2^n >= max(width, height) covers everything). Resizes `out`'s levels in place:
+// std::bad_alloc when that fails, as from the vectors (renderMultiview turns it into a Status).
 void buildNBuffer(const float* depth, uint32_t width, uint32_t height, uint32_t max_level,
                   NBuffer& out);
 

@@ -87,7 +87,8 @@ public:
     // Per-pixel fragment lists (Selgrad et al. 2015 §4): collect every fragment, then sort,
     // keep the closest desc.max_per_pixel and compact. When more than desc.node_capacity nodes
     // are needed: OverflowPolicy::Fail returns an error with both counts; Grow enlarges the
-    // pool to what was needed (out.grew, out.node_capacity_used).
+    // pool to what was needed (out.grew, out.node_capacity_used). `out`'s arrays are reused:
+    // a second call of the same size and lists into the same `out` allocates nothing.
     Status renderFragmentLists(const Scene& scene, const View& view, const RenderOptions& options,
                                const FragmentListDesc& desc, FragmentLists& out,
                                FrameStats* stats = nullptr);

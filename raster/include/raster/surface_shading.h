@@ -15,13 +15,20 @@
 namespace raster {
 
 // Prepared once per frame (lights, kernel choice); shade() is thread-safe and allocation-free.
-// The Scene must outlive it.
+// The Scene must outlive it (or the next prepare()).
 class SurfaceShader {
 public:
+    // Not prepared: call prepare() before shade().
+    SurfaceShader() noexcept;
     SurfaceShader(const Scene& scene, const View& view, bool simd = true);
     ~SurfaceShader();
     SurfaceShader(SurfaceShader&&) noexcept;
     SurfaceShader& operator=(SurfaceShader&&) noexcept;
+
+    // Prepares for a frame of `scene` through `view` (as the constructor does), reusing this
+    // shader's memory: the same number of lights as last time allocates nothing, so a shader
+    // kept between frames can be prepared again every frame.
+    void prepare(const Scene& scene, const View& view, bool simd = true);
 
     // Linear RGB leaving `world` towards `eye` for the surface `g` (g.unlit: base colour +
     // emissive; the shading mode was applied when the sample was written).
