@@ -22,7 +22,7 @@ const Param<S> kParams[] = {
      field<&S::max_radius_px>()},
     {{.name = "leak_scale",
       .flag = "gather-leak-scale",
-      .max = INFINITY,
+      .max = kUnbounded,
       .paper = "Zhou et al. 2007, §4.2",
       .help = "leakage control L = min(1, scale * r_centre) for samples behind the focal plane "
               "(per pixel of centre CoC)"},

@@ -74,8 +74,8 @@ const Param<S> kParams[] = {
      field<&S::blend>()},
     {{.name = "additive_gap",
       .flag = "additive-gap",
-      .max = INFINITY,
-      .special = {"inf", INFINITY},
+      .max = kUnbounded,
+      .special = {"inf", kUnbounded},
       .paper = "Selgrad et al. 2015, §7",
       .help = "additive blending within groups of slices whose depths are within a factor 1+G "
               "of the previous one, the over operator between groups (inf: the paper's one "

@@ -13,6 +13,7 @@
 #include <raster/status.h>
 
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -20,6 +21,9 @@
 #include <vector>
 
 namespace dof {
+
+// An unbounded range's max, and the value of the spelling "inf" (a double: the rows hold doubles).
+inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
 enum class ParamType : uint8_t {
     Number, // a float or integer field in [min, max] ((min, max] with min_open)
