@@ -122,7 +122,7 @@ std::string optionHelp(std::string_view method, const dof::ParamInfo& p) {
     // Only the snake_case names: a help line's plain words ("layers", "cone") are English.
     std::vector<Spelling> spellings = methodSpellings(method);
     std::erase_if(spellings, [](const Spelling& s) { return s.first.find('_') == s.first.npos; });
-    return std::string(method) + ": " + replaceWords(dof::paramHelp(p), spellings);
+    return std::string(method) + ": " + replaceWords(dof::paramHelp(p, false), spellings);
 }
 
 std::string optionFor(std::string_view method, std::string_view name) {

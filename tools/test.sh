@@ -2,7 +2,7 @@
 # README command (b): install what is missing, build, and run the whole test suite:
 # the Release build (every test: quick, full, golden and stress tiers; warnings as errors), the
 # installed package in projects outside the tree (tools/package-check.sh), the ASan+UBSan build
-# (quick tier), a clang++ Release build of focal and the golden tests (which must match the same
+# (quick tier, with the allocation and fault-injection tests), a clang++ Release build of focal and the golden tests (which must match the same
 # goldens as g++), ThreadSanitizer on the pinhole determinism sweeps, and each libFuzzer target
 # for 60 s (docs/testing.md, "What runs where"). Each step prints its wall time, so a slow CI run
 # shows where the time went.
@@ -24,8 +24,10 @@ step "release tests" ctest --preset release -j"$jobs"
 # with examples/embed, and the release build's install with examples/golden-installed.
 step "package" tools/package-check.sh
 cmake --preset asan-ubsan >/dev/null
-step "asan-ubsan build" cmake --build --preset asan-ubsan --target focal focal_unit_tests -- -j"$jobs"
-step "asan-ubsan quick tier" ctest --preset asan-ubsan -j"$jobs" -L quick
+step "asan-ubsan build" cmake --build --preset asan-ubsan \
+  --target focal focal_unit_tests focal_alloc_tests -- -j"$jobs"
+# The allocation tests' fault injection tries 40 values of K per method here (150 in Release).
+step "asan-ubsan quick tier" env FOCAL_FAULT_TRIALS=40 ctest --preset asan-ubsan -j"$jobs" -L quick
 cmake --preset clang-release >/dev/null
 # The preset's targets: focal, focal_golden_tests; its test filter: label golden.
 step "clang build" cmake --build --preset clang-release -- -j"$jobs"

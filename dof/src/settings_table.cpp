@@ -50,7 +50,7 @@ Status settingsError(std::string_view method, std::string_view what) {
     return Status::error(std::string(method) + " settings: " + std::string(what));
 }
 
-std::string paramHelp(const ParamInfo& p) {
+std::string paramHelp(const ParamInfo& p, bool spellings) {
     std::string out(p.help);
     std::string detail;
     switch (p.type) {
@@ -63,10 +63,10 @@ std::string paramHelp(const ParamInfo& p) {
         detail = "comma-separated, each " + rangePhrase(p);
         break;
     case ParamType::Choice:
-        detail = choicesText(p);
+        detail = spellings ? choicesText(p) : "";
         break;
     case ParamType::Switch:
-        detail = "on|off";
+        detail = spellings ? "on|off" : "";
         break;
     case ParamType::Flag:
         break;

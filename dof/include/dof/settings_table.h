@@ -125,7 +125,9 @@ template <class S> struct Param {
 };
 
 // The help line: "HELP (RANGE or CHOICES; PAPER)".
-std::string paramHelp(const ParamInfo& p);
+// `spellings`: false leaves out a switch's or choice's spellings (a --help line shows them as
+// the value's type).
+std::string paramHelp(const ParamInfo& p, bool spellings = true);
 // A value as the command line spells it: "2", "0.1", "on", "scan", "inf".
 std::string formatParamValue(const ParamInfo& p, double value);
 std::string formatParamList(const std::vector<uint32_t>& values);

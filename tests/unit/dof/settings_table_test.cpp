@@ -129,6 +129,9 @@ TEST(SettingsTable, SpellingsParseAndBadSpellingsAreRejected) {
     const dof::MultiviewSettings before = s;
     for (const char* text : {"", "1e", "nan", "inf ", "0x10", "-inf"})
         EXPECT_FALSE(dof::parseParam("multiview", row("overlap"), s, text).ok()) << text;
+    EXPECT_NE(dof::paramHelp(row("culling").info).find("(on|off; Lee et al. 2009, §4.3)"),
+              std::string::npos);
+    EXPECT_EQ(dof::paramHelp(row("culling").info, false).find("on|off"), std::string::npos);
     EXPECT_FALSE(dof::parseParam("multiview", row("culling"), s, "yes").ok());
     EXPECT_FALSE(dof::parseParam("multiview", row("traversal"), s, "bisect").ok());
     EXPECT_EQ(s.overlap, before.overlap); // a failed parse leaves the field alone
