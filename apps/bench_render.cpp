@@ -86,7 +86,7 @@ RenderRun renderInMemory(const std::vector<std::string>& args, const LoadedScene
     r.image = ImageData{frame->width, frame->height, 4, std::move(frame->color)};
     if (!frame->depth.empty())
         r.depth = ImageData{frame->width, frame->height, 1, std::move(frame->depth)};
-    r.stats = nlohmann::ordered_json::parse(frame->stats.dump());
+    r.stats = nlohmann::ordered_json(frame->stats); // the same keys, in the same (sorted) order
     return r;
 }
 

@@ -75,12 +75,8 @@ std::string optionTypeName(const dof::ParamInfo& p) {
         return p.special.spelling.empty() ? "NUMBER" : "NUMBER|" + std::string(p.special.spelling);
     case dof::ParamType::List:
         return "N,N,...";
-    case dof::ParamType::Choice: {
-        std::string out;
-        for (const dof::ParamChoice& c : p.choices)
-            out += (out.empty() ? "" : "|") + std::string(c.spelling);
-        return out;
-    }
+    case dof::ParamType::Choice:
+        return dof::paramChoices(p);
     case dof::ParamType::Switch:
     case dof::ParamType::Flag:
         break;

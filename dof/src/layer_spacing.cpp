@@ -1,6 +1,7 @@
 #include "out_of_memory.h"
 
 #include <dof/layer_spacing.h>
+#include <dof/settings_table.h>
 
 #include <algorithm>
 #include <cmath>
@@ -77,9 +78,9 @@ DepthRange visibleDepthRange(const raster::Frame& pinhole, const raster::View& v
 Status layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range, float delta_px,
                              uint32_t max_layers, LayerSpacing& out) try {
     if (!std::isfinite(delta_px) || !(delta_px > 0.0f))
-        return Status::error("multiview settings: layer_spacing_px must be > 0");
+        return settingsError("multiview", "layer_spacing_px must be > 0");
     if (max_layers == 0)
-        return Status::error("multiview settings: the layer budget must be at least 1");
+        return settingsError("multiview", "the layer budget must be at least 1");
     if (Status st = checkRange(range); !st.ok())
         return st;
     const double span =
@@ -103,7 +104,7 @@ Status layerSpacingFromDelta(const ThinLens& lens, const DepthRange& range, floa
 Status layerSpacingFromCount(const ThinLens& lens, const DepthRange& range, uint32_t layers,
                              LayerSpacing& out) try {
     if (layers == 0)
-        return Status::error("multiview settings: layers must be at least 1");
+        return settingsError("multiview", "layers must be at least 1");
     if (Status st = checkRange(range); !st.ok())
         return st;
     const double span =

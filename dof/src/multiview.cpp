@@ -102,8 +102,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         (layers.gbuffer.size() != layer_texels || !shading.scene ||
          (layers.hasTransparency() && (layers.transparent_gbuffer.size() != layer_texels ||
                                        layers.transparent_top_alpha.size() != layer_texels))))
-        return Status::error("multiview settings: view_dependent needs layers rendered with a "
-                             "G-buffer");
+        return settingsError("multiview", "view_dependent needs layers rendered with a G-buffer");
 
     MultiviewStats stats;
     const uint32_t m = layers.layer_count;

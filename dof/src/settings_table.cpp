@@ -33,18 +33,18 @@ std::string rangePhrase(const ParamInfo& p) {
     return (std::isinf(p.max) ? "" : "in ") + rangeText(p);
 }
 
-std::string choicesText(const ParamInfo& p) {
-    std::string out;
-    for (const ParamChoice& c : p.choices)
-        out += (out.empty() ? "" : "|") + std::string(c.spelling);
-    return out;
-}
-
 std::string quoted(std::string_view text) {
     return "'" + std::string(text) + "'";
 }
 
 } // namespace
+
+std::string paramChoices(const ParamInfo& p) {
+    std::string out;
+    for (const ParamChoice& c : p.choices)
+        out += (out.empty() ? "" : "|") + std::string(c.spelling);
+    return out;
+}
 
 Status settingsError(std::string_view method, std::string_view what) {
     return Status::error(std::string(method) + " settings: " + std::string(what));
@@ -63,7 +63,7 @@ std::string paramHelp(const ParamInfo& p, bool spellings) {
         detail = "comma-separated, each " + rangePhrase(p);
         break;
     case ParamType::Choice:
-        detail = spellings ? choicesText(p) : "";
+        detail = spellings ? paramChoices(p) : "";
         break;
     case ParamType::Switch:
         detail = spellings ? "on|off" : "";
@@ -112,7 +112,7 @@ Status checkParamValue(std::string_view method, const ParamInfo& p, double v) {
         for (const ParamChoice& c : p.choices)
             if (c.value == v)
                 return {};
-        return settingsError(method, std::string(p.name) + " must be one of " + choicesText(p));
+        return settingsError(method, std::string(p.name) + " must be one of " + paramChoices(p));
     case ParamType::Number:
     case ParamType::List:
         break;
@@ -156,7 +156,7 @@ Result<double> parseParamValue(std::string_view method, const ParamInfo& p, std:
             if (c.spelling == text)
                 return c.value;
         return settingsError(method,
-                             name + " must be one of " + choicesText(p) + ", got " + quoted(text));
+                             name + " must be one of " + paramChoices(p) + ", got " + quoted(text));
     case ParamType::Number:
     case ParamType::List:
         break;

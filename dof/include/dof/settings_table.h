@@ -125,6 +125,8 @@ template <class S> struct Param {
 };
 
 // The help line: "HELP (RANGE or CHOICES; PAPER)".
+// A choice row's spellings: "scan|false-position".
+std::string paramChoices(const ParamInfo& p);
 // `spellings`: false leaves out a switch's or choice's spellings (a --help line shows them as
 // the value's type).
 std::string paramHelp(const ParamInfo& p, bool spellings = true);
