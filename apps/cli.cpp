@@ -6,6 +6,7 @@
 #include "apps/render_command.h"
 #include "apps/scene_info.h"
 #include "apps/scene_source.h"
+#include "apps/steps_command.h"
 
 #include <raster/renderer.h>
 #include <raster/task_pool.h>
@@ -71,6 +72,15 @@ int runCli(int argc, char** argv) {
     BenchArgs bench_args;
     CLI::App* bench = addBenchCommand(app, bench_args);
 
+    StepsArgs steps_args;
+    CLI::App* steps = addStepsCommand(app, steps_args);
+    steps_args.command.assign(argv, argv + argc);
+    if (!steps_args.command.empty())
+        steps_args.command.front() = "focal";
+
+    ProbeArgs probe_args;
+    CLI::App* probe = addProbeCommand(app, probe_args);
+
     InfoArgs info_args;
     info_args.threads = std::max(1u, std::thread::hardware_concurrency());
     CLI::App* info = app.add_subcommand("info", "Describe a scene: triangles, meshes, materials, "
@@ -108,6 +118,10 @@ int runCli(int argc, char** argv) {
             return runHash(hash_args);
         if (bench->parsed())
             return runBench(bench_args);
+        if (steps->parsed())
+            return runSteps(steps_args);
+        if (probe->parsed())
+            return runProbe(probe_args);
         if (info->parsed())
             return runInfo(info_args);
     } catch (const std::bad_alloc&) {

@@ -168,8 +168,9 @@ Status renderRuns(const RenderJob& job, const dof::LensSampleSet& lens_samples,
         Result<dof::MethodSettings> method = methodSettings(job, lens_samples, bar);
         if (!method.ok())
             return method.status();
-        if (Status s = job.frames.render(job.scene, job.lens.view, job.lens.lens, job.options,
-                                         *method, image, &report);
+        if (Status s =
+                job.frames.render(job.scene, job.lens.view, job.lens.lens, job.options, *method,
+                                  image, &report, run + 1 == args.repeat ? args.observer : nullptr);
             !s.ok())
             return s;
         if (job.table_method) {

@@ -74,8 +74,11 @@ struct RenderArgs {
     std::optional<int> precision;
     std::optional<std::string> target_color, target_depth;
     // The methods beyond pinhole and accum with this command line's option values (their
-    // settings tables' options), made by addRenderCommand.
+    // settings tables' options), made by addRenderOptions.
     std::vector<MethodEntry> methods;
+    // Not an option: the observer of the last --repeat run's stages and probes
+    // (dof/frame_observer.h), for focal steps and focal probe.
+    dof::FrameObserver* observer = nullptr;
 };
 
 // A scene loaded once and rendered many times (focal bench): the scene, what loading took, and
@@ -110,6 +113,10 @@ raster::Result<RenderedFrame> renderFrame(const RenderArgs& args,
 
 // Registers the subcommand; `args` must outlive parsing.
 CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args);
+
+// Registers the render command's options on `cmd` (focal steps and focal probe share them); -o
+// only `with_output`.
+void addRenderOptions(CLI::App* cmd, RenderArgs& args, bool with_output);
 
 // Runs it; returns the exit code (errors are printed).
 int runRender(const RenderArgs& args);

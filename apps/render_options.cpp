@@ -12,12 +12,13 @@ namespace focal {
 namespace {
 
 // The scene, the image, the camera, the raster options, the method and what is written.
-void addFrameOptions(CLI::App* cmd, RenderArgs& args) {
+void addFrameOptions(CLI::App* cmd, RenderArgs& args, bool with_output) {
     cmd->add_option("scene", args.scene, "glTF file (.gltf/.glb) or builtin:NAME")->required();
-    cmd->add_option("-o,--output", args.outputs,
-                    "output image: .exr (linear float RGBA) or .png "
-                    "(8-bit sRGB)")
-        ->required();
+    if (with_output)
+        cmd->add_option("-o,--output", args.outputs,
+                        "output image: .exr (linear float RGBA) or .png "
+                        "(8-bit sRGB)")
+            ->required();
     cmd->add_option("--width", args.width, "image width in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1, 16384));
@@ -165,10 +166,9 @@ void addTargetOptions(CLI::App* cmd, RenderArgs& args) {
 
 } // namespace
 
-CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
-    CLI::App* cmd = app.add_subcommand("render", "Render a scene to an image");
+void addRenderOptions(CLI::App* cmd, RenderArgs& args, bool with_output) {
     args.threads = std::max(1u, std::thread::hardware_concurrency());
-    addFrameOptions(cmd, args);
+    addFrameOptions(cmd, args, with_output);
     addLensOptions(cmd, args);
     addTargetOptions(cmd, args);
     // Each method in apps/methods.cpp adds its own options, bound to this command line's table.
@@ -176,6 +176,11 @@ CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
     for (MethodEntry& m : args.methods)
         if (m.add_options)
             m.add_options(*cmd);
+}
+
+CLI::App* addRenderCommand(CLI::App& app, RenderArgs& args) {
+    CLI::App* cmd = app.add_subcommand("render", "Render a scene to an image");
+    addRenderOptions(cmd, args, true);
     return cmd;
 }
 

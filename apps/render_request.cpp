@@ -32,17 +32,6 @@ Result<glm::vec3> parseVec3(const std::string& option, const std::string& text) 
     return v;
 }
 
-Result<glm::uvec2> parsePixel(const std::string& option, const std::string& text) {
-    long long x = -1, y = -1;
-    char comma = 0;
-    std::istringstream in(text);
-    in >> x >> comma >> y;
-    if (!in || comma != ',' || !(in >> std::ws).eof() || x < 0 || y < 0 || x > 1000000 ||
-        y > 1000000)
-        return Status::error(option + " expects a pixel X,Y (integers >= 0), got '" + text + "'");
-    return glm::uvec2(uint32_t(x), uint32_t(y));
-}
-
 // --eye/--target/--up: a look-at camera whose default clip planes enclose the scene's bounds as
 // seen from the eye; its focus distance is the distance to the target.
 Result<raster::View> lookAtView(const raster::Scene& scene, const RenderArgs& args) {
@@ -73,6 +62,17 @@ Result<raster::View> lookAtView(const raster::Scene& scene, const RenderArgs& ar
 }
 
 } // namespace
+
+Result<glm::uvec2> parsePixel(const std::string& option, const std::string& text) {
+    long long x = -1, y = -1;
+    char comma = 0;
+    std::istringstream in(text);
+    in >> x >> comma >> y;
+    if (!in || comma != ',' || !(in >> std::ws).eof() || x < 0 || y < 0 || x > 1000000 ||
+        y > 1000000)
+        return Status::error(option + " expects a pixel X,Y (integers >= 0), got '" + text + "'");
+    return glm::uvec2(uint32_t(x), uint32_t(y));
+}
 
 Status checkRenderArgs(const RenderArgs& args) {
     if (args.tile % 8 != 0)

@@ -50,4 +50,7 @@ raster::Result<dof::ApertureShape> resolveAperture(const RenderArgs& args);
 
 dof::LensPattern lensPatternOf(const std::string& name);
 
+// A pixel "X,Y" (integers >= 0) given to `option`; the message names the option.
+raster::Result<glm::uvec2> parsePixel(const std::string& option, const std::string& text);
+
 } // namespace focal

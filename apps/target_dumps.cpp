@@ -1,5 +1,6 @@
 #include "apps/target_dumps.h"
 
+#include "apps/false_colour.h"
 #include "apps/image_io.h"
 #include "apps/text_file.h"
 
@@ -40,18 +41,6 @@ Status checkDir(const std::string& dir) {
     if (!std::filesystem::is_directory(dir, ec))
         return Status::error(dir + ": cannot create the dump folder");
     return {};
-}
-
-// A perceptual-ish heat map: black -> blue -> magenta -> orange -> white over [0, max].
-glm::vec3 heat(float t) {
-    t = std::clamp(t, 0.0f, 1.0f);
-    const glm::vec3 stops[5] = {
-        {0, 0, 0}, {0.05f, 0.1f, 0.6f}, {0.7f, 0.1f, 0.55f}, {1.0f, 0.55f, 0.05f}, {1, 1, 0.9f}};
-    const float x = t * 4.0f;
-    const int i = std::min(int(x), 3);
-    const glm::vec3 a = stops[i], b = stops[i + 1];
-    const float f = x - float(i);
-    return a + f * (b - a);
 }
 
 } // namespace

@@ -1,4 +1,5 @@
 #include "out_of_memory.h"
+#include "pinhole_view.h"
 
 #include <dof/frame_renderer.h>
 #include <raster/fragment_lists.h>
@@ -29,13 +30,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The view through the lens centre, without sub-pixel shift.
-raster::View pinholeView(const raster::View& view) {
-    raster::View v = view;
-    v.lens_offset = glm::vec2(0.0f);
-    v.pixel_shift = glm::vec2(0.0f);
-    return v;
-}
+using detail::pinholeView;
 
 bool isPinholeView(const raster::View& v) {
     return v.lens_offset == glm::vec2(0.0f) && v.pixel_shift == glm::vec2(0.0f) &&
@@ -187,10 +182,10 @@ const raster::Frame* FrameRenderer::lastPinhole(const raster::Scene& scene,
 raster::Status FrameRenderer::render(const raster::Scene& scene, const raster::View& view,
                                      const ThinLens& lens, const raster::RenderOptions& options,
                                      const MethodSettings& method, const FrameImage& image,
-                                     FrameReport* report_out) {
+                                     FrameReport* report_out, FrameObserver* observer) {
     Status s;
     try {
-        s = renderFrame(scene, view, lens, options, method, image, report_out);
+        s = renderFrame(scene, view, lens, options, method, image, report_out, observer);
     } catch (const std::bad_alloc&) {
         s = detail::outOfMemoryWhile([&] {
             return std::string("rendering ") + methodName(method) + " at " +
@@ -232,7 +227,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                                           const ThinLens& lens,
                                           const raster::RenderOptions& options,
                                           const MethodSettings& method, const FrameImage& image,
-                                          FrameReport* report_out) {
+                                          FrameReport* report_out, FrameObserver* observer) {
     // The pinhole made by pinhole() serves this frame only.
     const bool kept = pinhole_kept_;
     pinhole_kept_ = false;
@@ -268,6 +263,19 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
     if (!std::holds_alternative<PinholeMethod>(method))
         if (Status s = validate(lens, view); !s.ok())
             return s;
+    if (observer)
+        for (const glm::uvec2& p : observer->probePixels())
+            if (p.x >= view.width || p.y >= view.height)
+                return Status::error(std::string(name) + ": probe pixel " + std::to_string(p.x) +
+                                     "," + std::to_string(p.y) + " is outside the " +
+                                     std::to_string(view.width) + "x" +
+                                     std::to_string(view.height) + " image");
+    // After the method, the observer's stages and probes (frame_stages.cpp).
+    const auto observed = [&](Status s) -> Status {
+        if (!s.ok() || !observer)
+            return s;
+        return observeFrame(scene, view, lens, options, method, report, image, *observer);
+    };
     const raster::View pin = pinholeView(view);
     // Renders the pinhole into pinhole_ unless the kept one is this frame's.
     auto sharedPinhole = [&]() -> Status {
@@ -284,7 +292,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         copyRows(pinhole_.color.data(), view.width, view.height, image);
         if (image.depth)
             writeDepth(view, pinhole_.depth, false, image);
-        return {};
+        return observed({});
     }
 
     if (const AccumMethod* m = std::get_if<AccumMethod>(&method)) {
@@ -309,7 +317,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         };
         raster::Result<AccumStats> r =
             renderAccum(view, lens, *m->samples, m->settings, render_view, accum_, &pool_,
-                        m->progress, &accum_scratch_);
+                        observer ? observeAccum(view, lens, *m) : m->progress, &accum_scratch_);
         if (!r.ok())
             return r.status();
         copyRows(accum_.color.data(), view.width, view.height, image);
@@ -318,7 +326,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         report.stage_ms = {
             {"pinhole", r->ms_pinhole}, {"views", r->ms_views}, {"accumulate", r->ms_accumulate}};
         report.method_stats = *r;
-        return {};
+        return observed({});
     }
 
     if (const GatherMethod* m = std::get_if<GatherMethod>(&method)) {
@@ -337,8 +345,10 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         in.depth = depthRefOf(pinhole_.depth);
         in.width = pinhole_.width;
         in.height = pinhole_.height;
+        std::vector<float>* coc_out =
+            m->coc_out || !observer ? m->coc_out : &observedCoc(); // the stages show it
         raster::Result<GatherStats> r =
-            gather(in, lens, pin, settings, rgba_, m->coc_out, &pool_, &gather_scratch_);
+            gather(in, lens, pin, settings, rgba_, coc_out, &pool_, &gather_scratch_);
         if (!r.ok())
             return r.status();
         copyRows(rgba_.data(), view.width, view.height, image);
@@ -349,7 +359,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                            {"vertical", r->ms_vertical},
                            {"horizontal", r->ms_horizontal}};
         report.method_stats = *r;
-        return {};
+        return observed({});
     }
 
     if (const MultiviewMethod* m = std::get_if<MultiviewMethod>(&method)) {
@@ -407,7 +417,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                            {"mipmaps", r->ms_mipmaps},
                            {"tracing", r->ms_tracing}};
         report.method_stats = std::move(*r);
-        return {};
+        return observed({});
     }
 
     const MultilayerMethod& m = std::get<MultilayerMethod>(method);
@@ -415,6 +425,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
     MultilayerSettings& settings = multilayer_settings_;
     settings = m.settings;
     settings.memory_budget = options.memory_budget;
+    settings.level_contributions = settings.level_contributions || observer; // Fig. 7's stage
     if (m.samples) {
         settings.aperture = m.samples->shape();
         settings.aperture_second_moment = apertureSecondMoment(*m.samples);
@@ -447,7 +458,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                         size_t(view.width) * sizeof(float));
     report.stage_ms = {
         {"collect", st.ms_collect}, {"filter", st.ms_filter}, {"accumulate", st.ms_accumulate}};
-    return {};
+    return observed({});
 }
 
 } // namespace dof

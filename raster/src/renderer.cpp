@@ -104,6 +104,17 @@ bool hasBlendMaterial(const Scene& scene) {
 }
 } // namespace
 
+void Renderer::tileTriangleCounts(std::vector<uint32_t>& out, uint32_t& tiles_x,
+                                  uint32_t& tiles_y) const {
+    const State& st = *state_;
+    tiles_x = st.ctx.grid.tiles_x;
+    tiles_y = st.ctx.grid.tiles_y;
+    out.assign(st.ctx.grid.count(), 0);
+    for (const ChunkBins& bins : st.bins)
+        for (size_t t = 0; t + 1 < bins.offsets.size() && t < out.size(); ++t)
+            out[t] += bins.offsets[t + 1] - bins.offsets[t];
+}
+
 Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptions& options,
                          FrameStats* stats) {
     if (Status s = validate(options); !s.ok())

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <dof/accum.h>
+#include <dof/frame_observer.h>
 #include <dof/gather.h>
 #include <dof/lens.h>
 #include <dof/lens_resolution.h>
@@ -111,6 +112,13 @@ struct FrameReport {
         method_stats;
 };
 
+namespace detail {
+struct FrameObservation; // frame_stages.cpp: what observing a frame keeps
+struct FrameObservationDeleter {
+    void operator()(FrameObservation* p) const;
+};
+} // namespace detail
+
 class FrameRenderer {
 public:
     // Renders with the caller's pool (which must outlive this object); threads == 0 runs inline.
@@ -131,10 +139,14 @@ public:
     // memory while ..."), never an exception: this object then releases the method's kept
     // buffers and the pinhole frame, and the next call renders as a first frame does. Not
     // reentrant: one call at a time per object (the work itself runs on the pool).
+    // With an `observer` (frame_observer.h), the frame's stages and the observer's pixel probes
+    // are reported to it after the frame, on this thread; the frame's bytes are the same as
+    // without one. Probe pixels outside the image fail the call before anything is rendered.
     [[nodiscard]] raster::Status render(const raster::Scene& scene, const raster::View& view,
                                         const ThinLens& lens, const raster::RenderOptions& options,
                                         const MethodSettings& method, const FrameImage& image,
-                                        FrameReport* report = nullptr);
+                                        FrameReport* report = nullptr,
+                                        FrameObserver* observer = nullptr);
 
     // Renders the pinhole frame of `view` (lens centre) now, e.g. to choose the focus distance,
     // and keeps it for the next render() call (out of memory: a Status, as in render()): when that
@@ -178,7 +190,20 @@ private:
     raster::Status renderFrame(const raster::Scene& scene, const raster::View& view,
                                const ThinLens& lens, const raster::RenderOptions& options,
                                const MethodSettings& method, const FrameImage& image,
-                               FrameReport* report);
+                               FrameReport* report, FrameObserver* observer);
+    // Observing (frame_stages.cpp): the kept state, accum's progress hook that captures views
+    // and running averages, and the stages and probes after the frame.
+    detail::FrameObservation& observation();
+    std::vector<float>& observedCoc(); // gather's signed CoC map, for its stage
+    ProgressFn observeAccum(const raster::View& view, const ThinLens& lens, const AccumMethod& m);
+    raster::Status observeFrame(const raster::Scene& scene, const raster::View& view,
+                                const ThinLens& lens, const raster::RenderOptions& options,
+                                const MethodSettings& method, const FrameReport& report,
+                                const FrameImage& image, FrameObserver& observer);
+    void multiviewStages(const raster::View& view, const ThinLens& lens, const MultiviewMethod& m,
+                         const FrameReport& report, FrameObserver& observer);
+    void multilayerStages(const raster::View& pin, const FrameReport& report,
+                          FrameObserver& observer);
     // After running out of memory: drops the pinhole frame and `method`'s kept buffers.
     void releaseAfterFailure(const MethodSettings& method) noexcept;
     raster::Status renderPinhole(const raster::Scene& scene, const raster::View& view,
@@ -201,6 +226,7 @@ private:
     MultilayerImage multilayer_image_;
     MultilayerSettings multilayer_settings_; // the frame's, with what the frame renderer fills in
     FrameReport report_;                     // the report of a render() call given none
+    std::unique_ptr<detail::FrameObservation, detail::FrameObservationDeleter> observation_;
 };
 
 } // namespace dof

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 namespace raster {
 
@@ -92,6 +93,11 @@ public:
     Status renderFragmentLists(const Scene& scene, const View& view, const RenderOptions& options,
                                const FragmentListDesc& desc, FragmentLists& out,
                                FrameStats* stats = nullptr);
+
+    // Triangles binned to each tile by the last render call (any kind), summed over the geometry
+    // chunks, row-major over `tiles_x` x `tiles_y` tiles of options.tile_size pixels: the binning
+    // stage's load per tile, for looking inside (focal steps). Resizes `out`.
+    void tileTriangleCounts(std::vector<uint32_t>& out, uint32_t& tiles_x, uint32_t& tiles_y) const;
 
 private:
     Status prepare(const Scene& scene, const View& view, const RenderOptions& options,

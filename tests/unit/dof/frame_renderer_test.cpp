@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -156,11 +158,12 @@ std::vector<float> direct(const std::string& name, const raster::View& view,
 // One frame through `frames` into a tight image.
 std::vector<float> oneCall(dof::FrameRenderer& frames, const std::string& name,
                            const raster::View& view, const raster::RenderOptions& options = {},
-                           dof::FrameReport* report = nullptr) {
+                           dof::FrameReport* report = nullptr,
+                           dof::FrameObserver* observer = nullptr) {
     std::vector<float> rgba(size_t(view.width) * view.height * 4, -1.0f);
     const dof::FrameImage image{rgba.data(), size_t(view.width) * 4, nullptr, 0};
     const raster::Status s = frames.render(fixture().scene, view, lensOf(view), options,
-                                           methodNamed(name), image, report);
+                                           methodNamed(name), image, report, observer);
     EXPECT_TRUE(s.ok()) << name << ": " << s.message();
     return rgba;
 }
@@ -365,6 +368,161 @@ TEST(FrameRenderer, BadInputIsAStatusNamingTheProblem) {
     // A bad frame leaves the renderer usable: the next good one gives the right bytes.
     EXPECT_TRUE(sameBytes(oneCall(frames, "gather", viewOf(64, 48)),
                           direct("gather", viewOf(64, 48), {}, 0)));
+}
+
+// Keeps what a frame's observer is told (frame_observer.h): the stages' ids, copies of their
+// images, and the probes.
+struct Recorder final : dof::FrameObserver {
+    std::vector<glm::uvec2> pixels;
+    std::vector<std::string> ids;
+    std::vector<dof::Stage> stages; // images' pixels copied into `kept`
+    std::vector<std::vector<float>> kept;
+    std::vector<dof::PixelProbe> probes;
+    std::span<const glm::uvec2> probePixels() override { return pixels; }
+    void stage(const dof::Stage& stage) override {
+        ids.push_back(stage.id);
+        stages.push_back(stage);
+        for (dof::StageImage& img : stages.back().images) {
+            EXPECT_GE(img.stride, size_t(img.width) * img.channels) << stage.id << " " << img.name;
+            kept.emplace_back(img.pixels, img.pixels + img.stride * img.height);
+            img.pixels = kept.back().data();
+        }
+    }
+    void probe(const dof::PixelProbe& probe) override { probes.push_back(probe); }
+    const dof::Stage& find(const std::string& id) const {
+        for (const dof::Stage& s : stages)
+            if (s.id == id)
+                return s;
+        ADD_FAILURE() << "no stage " << id;
+        return stages.front();
+    }
+};
+
+TEST(FrameRenderer, AnObserverSeesEveryStageInOrderAndChangesNoByte) {
+    const raster::View view = viewOf(64, 48);
+    const std::vector<std::string> raster_stages = {"raster.geometry", "raster.binning",
+                                                    "raster.coverage", "raster.color",
+                                                    "targets.fragment_lists"};
+    const std::map<std::string, std::vector<std::string>> method_stages = {
+        {"pinhole", {}},
+        {"accum", {"accum.lens", "accum.views", "accum.average"}},
+        {"gather", {"gather.coc", "gather.vertical", "gather.horizontal"}},
+        {"multiview",
+         {"multiview.decomposition", "targets.layers", "multiview.nbuffer", "multiview.mipmaps",
+          "multiview.lens", "multiview.tracing"}},
+        {"multilayer",
+         {"multilayer.collect", "multilayer.levels", "multilayer.borders",
+          "multilayer.accumulate"}}};
+    for (uint32_t threads : {0u, 2u}) {
+        raster::TaskPool pool(threads);
+        for (const auto& [name, stages] : method_stages) {
+            dof::FrameRenderer plain(pool), observed(pool);
+            const std::vector<float> want = oneCall(plain, name, view);
+            Recorder rec;
+            rec.pixels = {{0, 0}, {31, 20}, {63, 47}};
+            EXPECT_TRUE(sameBytes(oneCall(observed, name, view, {}, nullptr, &rec), want)) << name;
+            // The next frame without an observer is not disturbed by the observed one.
+            EXPECT_TRUE(sameBytes(oneCall(observed, name, view), want)) << name;
+            std::vector<std::string> ids = raster_stages;
+            ids.insert(ids.end(), stages.begin(), stages.end());
+            ids.push_back("result.image");
+            EXPECT_EQ(rec.ids, ids) << name;
+            // Each probe's colour is the frame's pixel, bit for bit.
+            ASSERT_EQ(rec.probes.size(), rec.pixels.size()) << name;
+            for (const dof::PixelProbe& p : rec.probes)
+                EXPECT_EQ(
+                    std::memcmp(p.rgba, &want[(size_t(p.y) * view.width + p.x) * 4], sizeof p.rgba),
+                    0)
+                    << name << " " << p.x << "," << p.y;
+            // The result stage shows the result.
+            const dof::StageImage& result = rec.find("result.image").images.at(0);
+            EXPECT_EQ(std::memcmp(result.pixels, want.data(), want.size() * sizeof(float)), 0)
+                << name;
+        }
+    }
+}
+
+TEST(FrameRenderer, ObservedStagesHoldWhatTheFrameMade) {
+    const raster::View view = viewOf(64, 48);
+    raster::TaskPool pool(2);
+    dof::FrameRenderer frames(pool);
+    Recorder rec;
+    for (uint32_t y = 0; y < view.height; y += 5)
+        for (uint32_t x = 0; x < view.width; x += 7)
+            rec.pixels.emplace_back(x, y);
+    const std::vector<float> pinhole = oneCall(frames, "pinhole", view, {}, nullptr, &rec);
+    // The colour target is the pinhole frame.
+    const dof::StageImage& color = rec.find("raster.color").images.at(0);
+    EXPECT_EQ(std::memcmp(color.pixels, pinhole.data(), pinhole.size() * sizeof(float)), 0);
+    // The tile heat map adds up to the count it reports, over ceil(64/64) x ceil(48/64) tiles.
+    const dof::Stage& binning = rec.find("raster.binning");
+    const dof::StageImage& heat = binning.images.at(0);
+    EXPECT_EQ(heat.width, 1u);
+    EXPECT_EQ(heat.height, 1u);
+    EXPECT_EQ(heat.scale, 64u);
+    double sum = 0.0;
+    for (uint32_t i = 0; i < heat.width * heat.height; ++i)
+        sum += double(heat.pixels[i]);
+    for (const auto& [n, v] : binning.counts) {
+        if (n == "binned_triangles") {
+            EXPECT_EQ(v, sum);
+        }
+    }
+    EXPECT_GT(sum, 0.0);
+    // Probes: the fragments are nearest first; the nearest one is the geometry stage's triangle,
+    // the list length is the coverage stage's count, and an opaque scene's pinhole pixel is the
+    // nearest fragment's colour.
+    const dof::StageImage& nearest = rec.find("raster.geometry").images.at(0);
+    const dof::StageImage& counts = rec.find("raster.coverage").images.at(1);
+    ASSERT_EQ(rec.probes.size(), rec.pixels.size());
+    size_t covered = 0;
+    for (const dof::PixelProbe& p : rec.probes) {
+        const size_t i = size_t(p.y) * view.width + p.x;
+        EXPECT_EQ(float(p.fragments.size()), counts.pixels[i]) << p.x << "," << p.y;
+        for (size_t k = 1; k < p.fragments.size(); ++k)
+            EXPECT_LE(p.fragments[k - 1].distance, p.fragments[k].distance);
+        if (p.fragments.empty()) {
+            EXPECT_EQ(nearest.pixels[i], -1.0f);
+            continue;
+        }
+        ++covered;
+        EXPECT_EQ(nearest.pixels[i], float(p.fragments[0].primitive));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(p.rgba[c], p.fragments[0].rgba[c]) << p.x << "," << p.y << " channel " << c;
+    }
+    EXPECT_GT(covered, rec.probes.size() / 2);
+}
+
+TEST(FrameRenderer, AccumsLastRunningAverageIsItsResult) {
+    const raster::View view = viewOf(48, 32);
+    raster::TaskPool pool(2);
+    dof::FrameRenderer frames(pool);
+    Recorder rec;
+    const std::vector<float> result = oneCall(frames, "accum", view, {}, nullptr, &rec);
+    const dof::Stage& avg = rec.find("accum.average");
+    // After 1, 2, 4 and 8 views (the fixture's few samples).
+    ASSERT_EQ(avg.images.size(), 4u);
+    EXPECT_EQ(avg.images.back().name, "after 8 views");
+    EXPECT_EQ(std::memcmp(avg.images.back().pixels, result.data(), result.size() * sizeof(float)),
+              0);
+    EXPECT_EQ(rec.find("accum.views").images.size(), 4u);
+    EXPECT_EQ(rec.find("accum.lens").plots.at(0).points.size(), 8u);
+}
+
+TEST(FrameRenderer, AProbeOutsideTheImageIsAnError) {
+    const raster::View view = viewOf(32, 24);
+    raster::TaskPool pool(0);
+    dof::FrameRenderer frames(pool);
+    Recorder rec;
+    rec.pixels = {{32, 0}};
+    std::vector<float> rgba(32 * 24 * 4);
+    const raster::Status s =
+        frames.render(fixture().scene, view, lensOf(view), {}, methodNamed("gather"),
+                      dof::FrameImage{rgba.data(), 32 * 4, nullptr, 0}, nullptr, &rec);
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("probe pixel 32,0 is outside the 32x24 image"), std::string::npos)
+        << s.message();
+    EXPECT_TRUE(rec.ids.empty());
 }
 
 } // namespace
