@@ -127,6 +127,13 @@ void rowTaps(const TraversalFrame& tf, uint32_t y, TapRows (&rows)[2][kMaxTraver
             rows[side][s] = tapRows(*tf.tlevel[side][s], tf.st->ty[s][y]);
 }
 
+// The cursors of one pixel's taps, per side and level of T: working memory a row's task reuses
+// for its pixels (not initialised per pixel: traversePixel sets what it reads).
+struct PixelCursors {
+    Cursor cursors[2][kMaxTraversalLevels][4];
+    uint32_t count[2][kMaxTraversalLevels];
+};
+
 // The render's recorder: records nothing (every call compiles away).
 struct NoRecorder {
     void tap(uint32_t, uint32_t, uint32_t, uint32_t, uint32_t, const LayerFragment*, float) {}
@@ -144,15 +151,15 @@ struct NoRecorder {
 // fragment[, level weight, share]), every slice and the final coverage.
 template <class Recorder>
 uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTraversalLevels],
-                       uint32_t x, float* out, std::vector<std::vector<float>>* level_rgba,
-                       size_t p, Recorder& rec) {
+                       PixelCursors& pc, uint32_t x, float* out,
+                       std::vector<std::vector<float>>* level_rgba, size_t p, Recorder& rec) {
     const Multilayer::Traversal& st = *tf.st;
     const std::vector<LevelBorders::Segment>& segments = st.segments;
     // Bilinear taps of every level at the pixel centre, in the order (i0, j0), (i1, j0),
     // (i0, j1), (i1, j1); taps with weight 0 or an empty list are left out, since they add w·0
     // to every slice. `present` marks the levels with a tap left, per side.
-    Cursor cursors[2][kMaxTraversalLevels][4];
-    uint32_t cursor_count[2][kMaxTraversalLevels];
+    Cursor(&cursors)[2][kMaxTraversalLevels][4] = pc.cursors;
+    uint32_t(&cursor_count)[2][kMaxTraversalLevels] = pc.count;
     uint64_t present[2] = {0, 0};
     for (uint32_t side = 0; side < tf.sides; ++side)
         for (uint32_t s = 0; s <= tf.n; ++s) {
@@ -655,6 +662,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         // a weight > 0 that hold fragments (the others add w·0 to no slice).
         TapRows rows[2][kMaxTraversalLevels];
         rowTaps(tf, y, rows);
+        PixelCursors cursors;
         NoRecorder none;
         uint64_t slices = 0; // stored once: neighbouring rows' counts share cache lines
         for (uint32_t x = 0; x < width; ++x) {
@@ -665,7 +673,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
                 if (count > 0)
                     out.depth[p] = base[0].depth;
             }
-            slices += traversePixel(tf, rows, x, out.rgba.data() + 4 * p,
+            slices += traversePixel(tf, rows, cursors, x, out.rgba.data() + 4 * p,
                                     contributions ? &out.level_rgba : nullptr, p, none);
         }
         row_slices[y] = slices;
@@ -836,8 +844,9 @@ raster::Status Multilayer::probe(uint32_t x, uint32_t y, MultilayerPixelProbe& o
     const TraversalFrame tf = traversalFrame(plan_, levels_, apertures_, borders_, st);
     TapRows rows[2][kMaxTraversalLevels];
     rowTaps(tf, y, rows);
+    PixelCursors cursors;
     ProbeRecorder rec{tf, out};
-    traversePixel(tf, rows, x, out.rgba, nullptr, 0, rec);
+    traversePixel(tf, rows, cursors, x, out.rgba, nullptr, 0, rec);
     return {};
 } catch (const std::bad_alloc&) {
     return detail::outOfMemory("probing multilayer");
