@@ -42,12 +42,7 @@ const Demo& demo() {
 }
 
 dof::GatherImage imageOf(const raster::Frame& f) {
-    dof::GatherImage img;
-    img.rgba = f.color.data();
-    img.depth = dof::depthRefOf(f.depth);
-    img.width = f.width;
-    img.height = f.height;
-    return img;
+    return {f.color.data(), dof::depthRefOf(f.depth), f.width, f.height};
 }
 
 bool sameBits(const float* a, const float* b, size_t n = 4) {
