@@ -13,7 +13,8 @@
 //   horizontal  the same filter along the rows of the vertical pass's output.
 // Each output pixel is computed by exactly one task, its samples summed in a fixed order, so the
 // bytes do not depend on the thread count or the tile size. Tiles the lens cannot change are
-// copied (see GatherStats); the copy is exact, the same bits as filtering them.
+// copied (see GatherStats); the copy is exact, the same bits as filtering them. probeGather
+// re-runs one pixel's passes on the kept GatherScratch and records every tap.
 #pragma once
 
 #include <dof/lens.h>

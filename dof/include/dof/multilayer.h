@@ -3,7 +3,8 @@
 // raster::Renderer::renderFragmentLists); builds the filtered level hierarchy (§5, see
 // dof/fragment_levels.h) and accumulates it per pixel guided by the circle of confusion (§6).
 // Produces a linear RGBA image owned by the caller. A Multilayer object keeps the lists and the
-// levels between frames (no reallocation once warm) and exposes them for stepping and dumps.
+// levels between frames (no reallocation once warm) and exposes them for stepping and dumps;
+// probe() re-runs one pixel's traversal on them and records what it read.
 //
 // Determinism: every cell and every output pixel is computed by one task in a fixed order
 // (merges break depth ties by list index), so the bytes do not depend on the thread count.
