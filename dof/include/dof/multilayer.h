@@ -189,7 +189,8 @@ struct MultilayerProbeRead {
     int32_t x = 0, y = 0;      // the cell at that level (FragmentLevel geometry)
     uint32_t segment = 0;      // the segment of T (LevelBorders::Segment, split at d_f when the
                                // aperture is asymmetric) whose cursor met it
-    uint32_t blend = 0;        // the slice it joined: index into MultilayerPixelProbe::slices
+    uint32_t blend = 0;        // the slice it joined (skipped: whose search skipped it; equal
+                               // to slices.size() if none followed): MultilayerPixelProbe::slices
     bool accepted = false;     // merged into that slice; false: skipped, since it lies in front of
                                // the segment (that level is not asked for its depth, §6.1)
     float depth = 0.0f;        // view distance of the (merged) fragment
