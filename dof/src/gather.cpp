@@ -134,20 +134,46 @@ bool pixelTerms(const GatherImage& image, const CocAffine& ca, const GatherSetti
     return true;
 }
 
-// The weight of one sample at offset k (|k| = dist >= 1) for a centre whose leak factor is
-// leak_c: W(P) = O(r_p) I(r_p) L(z_p) (§4.2), with O(r_p) = clamp(r_p - d_p, 0, 1): 0 when
-// r_p <= d_p, the fractional ramp r_p - d_p up to d_{p+1} = d_p + 1, then 1. The clamps are
-// written as SSE's MAXPS/MINPS define them ((a > b) ? a : b, (a < b) ? a : b), so the SSE2 path
-// below produces the same bits, signed zeros included.
-inline float sampleWeight(float r_p, float i_p, float behind_p, float leak_c, float dist) {
+// The factors of one sample's weight W(P) = O(r_p) I(r_p) L(z_p) (§4.2), evaluated as (O I) L.
+struct SampleFactors {
+    float overlap, intensity, leakage;
+    float weight() const { return (overlap * intensity) * leakage; }
+};
+
+// The factors of one sample at offset k (|k| = dist >= 1) for a centre whose leak factor is
+// leak_c, with O(r_p) = clamp(r_p - d_p, 0, 1): 0 when r_p <= d_p, the fractional ramp r_p - d_p
+// up to d_{p+1} = d_p + 1, then 1. The clamps are written as SSE's MAXPS/MINPS define them
+// ((a > b) ? a : b, (a < b) ? a : b), so the SSE2 path below produces the same bits, signed zeros
+// included.
+inline SampleFactors sampleFactors(float r_p, float i_p, float behind_p, float leak_c, float dist) {
     const float t = r_p - dist;
     const float t0 = t > 0.0f ? t : 0.0f;
     const float o = t0 < 1.0f ? t0 : 1.0f;
     // L(z_p): leak_c behind the focal plane (behind_p = 1), else 1. Exact for behind_p in {0, 1}
     // (no rounding: 1*x + 0 and 0*x + 1), and branch-free.
     const float l = behind_p * leak_c + (1.0f - behind_p);
-    return (o * i_p) * l;
+    return {o, i_p, l};
 }
+
+// One iteration of the §5 inner loop for one centre: adds the sample's weight to the sums and its
+// weighted colour c_p to acc, then hands the factors, the weight and c_p to `tap` (the probe's
+// recorder; a no-op for the render, which compiles away).
+template <class TapFn>
+inline void addSample(float r_p, float i_p, float behind_p, float leak_c, float dist,
+                      const float* c_p, float& wsum, float& nsum, float* acc, TapFn&& tap) {
+    const SampleFactors f = sampleFactors(r_p, i_p, behind_p, leak_c, dist);
+    const float w = f.weight();
+    wsum += w;
+    nsum += w;
+    for (uint32_t c = 0; c < 4; ++c)
+        acc[c] += w * c_p[c];
+    tap(f, w, c_p);
+}
+
+// The render's recorder: records nothing.
+struct NoTaps {
+    void operator()(const SampleFactors&, float, const float*) const {}
+};
 
 // Adds the samples at one offset k (|k| = dist) to a row of n centres: the inner loop of the §5
 // pseudo-code, run for n centres at once. Per centre the terms are added in the same order, with
@@ -184,13 +210,9 @@ void addSamples(const float* r_s, const float* i_s, const float* b_s, const floa
 #else
     (void)simd;
 #endif
-    for (; x < n; ++x) {
-        const float w = sampleWeight(r_s[x], i_s[x], b_s[x], leak_c[x], dist);
-        wsum[x] += w;
-        nsum[x] += w;
-        for (uint32_t c = 0; c < 4; ++c)
-            acc[4 * x + c] += w * c_s[4 * x + c];
-    }
+    for (; x < n; ++x)
+        addSample(r_s[x], i_s[x], b_s[x], leak_c[x], dist, c_s + 4 * x, wsum[x], nsum[x],
+                  acc + 4 * x, NoTaps{});
 }
 
 // Renormalisation (§4.2 "renormalizes the result"): when no neighbour contributed the centre is
@@ -206,6 +228,90 @@ inline void resolvePixel(const float* acc, float wsum, float nsum, const float* 
         for (int c = 0; c < 4; ++c)
             out[c] = centre[c];
     }
+}
+
+// The per-pixel terms of the coc stage, one array each (GatherScratch's, or the reference's).
+struct TermArrays {
+    const float* radius;
+    const float* intensity;
+    const float* behind;
+    const float* leak;
+};
+
+// One output pixel (x, y) of one 1-D pass, the §5 pseudo-code: the centre's term W(C) = I(r_c),
+// then the samples at k = -k_max..k_max (k != 0) of `src` (w x h RGBA) down the column
+// (`vertical`) or along the row, clamped to the edge with the distance kept |k|; renormalised
+// into `out` (4 floats). The same sums, in the same order, as addSamples for a row of centres.
+// `rec.tap(x, y, k, factors, weight, rgba)` sees every term (the centre with factors {1, I, 1}).
+template <class Recorder>
+void filterPixel(const TermArrays& t, const float* src, uint32_t w, uint32_t h, bool vertical,
+                 uint32_t x, uint32_t y, uint32_t k_max, float* out, Recorder& rec) {
+    const size_t ci = size_t(y) * w + x;
+    const float* centre = src + ci * 4;
+    const float ic = t.intensity[ci];
+    float acc[4];
+    for (int c = 0; c < 4; ++c)
+        acc[c] = ic * centre[c];
+    float wsum = ic, nsum = 0.0f;
+    rec.tap(x, y, 0, SampleFactors{1.0f, ic, 1.0f}, ic, centre);
+    for (int k = -int(k_max); k <= int(k_max); ++k) {
+        if (k == 0)
+            continue;
+        const uint32_t sx = vertical ? x : uint32_t(std::clamp(int(x) + k, 0, int(w) - 1));
+        const uint32_t sy = vertical ? uint32_t(std::clamp(int(y) + k, 0, int(h) - 1)) : y;
+        const size_t si = size_t(sy) * w + sx;
+        addSample(t.radius[si], t.intensity[si], t.behind[si], t.leak[ci], float(std::abs(k)),
+                  src + si * 4, wsum, nsum, acc,
+                  [&](const SampleFactors& f, float wt, const float* c) {
+                      rec.tap(sx, sy, k, f, wt, c);
+                  });
+    }
+    resolvePixel(acc, wsum, nsum, centre, out);
+}
+
+// The reference's recorder: records nothing.
+struct NoRecorder {
+    void tap(uint32_t, uint32_t, int, const SampleFactors&, float, const float*) const {}
+};
+
+Plan makePlan(const GatherImage& image, const GatherSettings& settings) {
+    Plan p;
+    p.width = image.width;
+    p.height = image.height;
+    p.tile = settings.tile_size;
+    p.tiles_x = (p.width + p.tile - 1) / p.tile;
+    p.tiles_y = (p.height + p.tile - 1) / p.tile;
+    p.reach = fullReach(settings);
+    p.row_blocks = (p.height + kBlock - 1) / kBlock;
+    p.col_blocks = (p.width + kBlock - 1) / kBlock;
+    return p;
+}
+
+// The loop bound K of a pass for the centres [first, last] along it (`extent` pixels long):
+// with skip_tiles the reach of the largest radius within the full reach of them, read from the
+// pass's reach blocks (`blocks`: one per 8 pixels along the pass); else the full reach.
+uint32_t passReach(const Plan& p, const GatherSettings& s, const float* blocks, uint32_t first,
+                   uint32_t last, uint32_t extent) {
+    if (!s.skip_tiles)
+        return p.reach;
+    const uint32_t lo = first >= p.reach ? (first - p.reach) / kBlock : 0;
+    const uint32_t hi = std::min(extent - 1, last + p.reach) / kBlock;
+    float max_r = 0.0f;
+    for (uint32_t b = lo; b <= hi; ++b)
+        max_r = std::max(max_r, blocks[b]);
+    return std::min(p.reach, reachOf(max_r));
+}
+
+// The vertical pass's bound for the rows [yb, yb + 8) of tile column `tile_col`.
+uint32_t verticalReach(const Plan& p, const GatherSettings& s, const float* vblock,
+                       uint32_t tile_col, uint32_t yb) {
+    return passReach(p, s, vblock + size_t(tile_col) * p.row_blocks, yb, yb + kBlock - 1, p.height);
+}
+
+// The horizontal pass's bound for the pixels [x0, x1) of row y.
+uint32_t horizontalReach(const Plan& p, const GatherSettings& s, const float* hblock, uint32_t y,
+                         uint32_t x0, uint32_t x1) {
+    return passReach(p, s, hblock + size_t(y) * p.col_blocks, x0, x1 - 1, p.width);
 }
 
 } // namespace
@@ -266,15 +372,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
     GatherScratch local;
     GatherScratch& ws = scratch ? *scratch : local;
 
-    Plan p;
-    p.width = image.width;
-    p.height = image.height;
-    p.tile = settings.tile_size;
-    p.tiles_x = (p.width + p.tile - 1) / p.tile;
-    p.tiles_y = (p.height + p.tile - 1) / p.tile;
-    p.reach = fullReach(settings);
-    p.row_blocks = (p.height + kBlock - 1) / kBlock;
-    p.col_blocks = (p.width + kBlock - 1) / kBlock;
+    const Plan p = makePlan(image, settings);
     const size_t pixels = size_t(p.width) * p.height;
     const uint32_t tiles = p.tiles_x * p.tiles_y;
     const uint32_t workers = pool ? pool->workerCount() : 1u;
@@ -376,17 +474,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
         bool any_filtered = false;
         for (uint32_t yb = y0; yb < y1; yb += kBlock) {
             // Loop bound for these rows: the largest radius within the full reach.
-            uint32_t k_max = 0;
-            if (settings.skip_tiles) {
-                const uint32_t lo = yb >= p.reach ? (yb - p.reach) / kBlock : 0;
-                const uint32_t hi = std::min(p.height - 1, yb + kBlock - 1 + p.reach) / kBlock;
-                float max_r = 0.0f;
-                for (uint32_t b = lo; b <= hi; ++b)
-                    max_r = std::max(max_r, vblock[size_t(tile % p.tiles_x) * p.row_blocks + b]);
-                k_max = std::min(p.reach, reachOf(max_r));
-            } else {
-                k_max = p.reach;
-            }
+            const uint32_t k_max = verticalReach(p, settings, vblock.data(), tile % p.tiles_x, yb);
             const uint32_t ye = std::min(y1, yb + kBlock);
             if (k_max == 0) {
                 // No neighbour can reach: every output is its centre (resolvePixel).
@@ -447,15 +535,7 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
         for (uint32_t y = y0; y < y1; ++y) {
             const size_t row = size_t(y) * p.width;
             const float* src = ws.vertical.data() + row * 4;
-            uint32_t k_max = p.reach;
-            if (settings.skip_tiles) {
-                const uint32_t lo = x0 >= p.reach ? (x0 - p.reach) / kBlock : 0;
-                const uint32_t hi = std::min(p.width - 1, x1 - 1 + p.reach) / kBlock;
-                float max_r = 0.0f;
-                for (uint32_t b = lo; b <= hi; ++b)
-                    max_r = std::max(max_r, hblock[size_t(y) * p.col_blocks + b]);
-                k_max = std::min(p.reach, reachOf(max_r));
-            }
+            const uint32_t k_max = horizontalReach(p, settings, hblock.data(), y, x0, x1);
             float* out = out_rgba.data() + (row + x0) * 4;
             if (k_max == 0) {
                 std::copy_n(src + size_t(x0) * 4, size_t(n) * 4, out);
@@ -519,53 +599,109 @@ Result<GatherStats> gatherReference(const GatherImage& image, const ThinLens& le
     GatherStats stats;
     stats.tiles = 1;
     stats.coc = cocAffine(lens, view);
-    std::vector<PixelTerms> terms(pixels);
+    std::vector<float> radius(pixels), intensity(pixels), behind(pixels), leak(pixels);
     stats.min_coc_px = INFINITY;
     stats.max_coc_px = -INFINITY;
     for (size_t i = 0; i < pixels; ++i) {
         bool bad_depth = false;
-        if (!pixelTerms(image, stats.coc, settings, i, terms[i], bad_depth))
+        PixelTerms t{};
+        if (!pixelTerms(image, stats.coc, settings, i, t, bad_depth))
             return badInput(image, i, bad_depth);
-        stats.min_coc_px = std::min(stats.min_coc_px, terms[i].coc);
-        stats.max_coc_px = std::max(stats.max_coc_px, terms[i].coc);
-        stats.clamped_pixels += std::fabs(terms[i].coc) > settings.max_radius_px ? 1u : 0u;
+        radius[i] = t.radius;
+        intensity[i] = t.intensity;
+        behind[i] = t.behind;
+        leak[i] = t.leak;
+        stats.min_coc_px = std::min(stats.min_coc_px, t.coc);
+        stats.max_coc_px = std::max(stats.max_coc_px, t.coc);
+        stats.clamped_pixels += std::fabs(t.coc) > settings.max_radius_px ? 1u : 0u;
     }
-    const int reach = int(fullReach(settings));
-    // One 1-D pass of the §5 pseudo-code: `step` is the pixel-index stride along the pass.
-    auto pass = [&](const std::vector<float>& src, std::vector<float>& dst, bool vertical) {
-        for (uint32_t y = 0; y < h; ++y)
-            for (uint32_t x = 0; x < w; ++x) {
-                const size_t ci = size_t(y) * w + x;
-                const PixelTerms& tc = terms[ci];
-                float acc[4];
-                for (int c = 0; c < 4; ++c)
-                    acc[c] = tc.intensity * src[ci * 4 + c];
-                float wsum = tc.intensity, nsum = 0.0f;
-                for (int k = -reach; k <= reach; ++k) {
-                    if (k == 0)
-                        continue;
-                    const size_t si =
-                        vertical ? size_t(std::clamp(int(y) + k, 0, int(h) - 1)) * w + x
-                                 : size_t(y) * w + size_t(std::clamp(int(x) + k, 0, int(w) - 1));
-                    const PixelTerms& ts = terms[si];
-                    const float wt = sampleWeight(ts.radius, ts.intensity, ts.behind, tc.leak,
-                                                  float(std::abs(k)));
-                    wsum += wt;
-                    nsum += wt;
-                    for (int c = 0; c < 4; ++c)
-                        acc[c] += wt * src[si * 4 + c];
-                    ++stats.samples;
-                }
-                resolvePixel(acc, wsum, nsum, &src[ci * 4], &dst[ci * 4]);
-            }
-    };
-    std::vector<float> input(image.rgba, image.rgba + pixels * 4), vertical(pixels * 4);
+    const TermArrays terms{radius.data(), intensity.data(), behind.data(), leak.data()};
+    const uint32_t reach = fullReach(settings);
+    NoRecorder none;
+    // The two 1-D passes of the §5 pseudo-code, every pixel over the full reach.
+    std::vector<float> vertical(pixels * 4);
     out_rgba.resize(pixels * 4);
-    pass(input, vertical, true);
-    pass(vertical, out_rgba, false);
+    for (bool vert : {true, false}) {
+        const float* src = vert ? image.rgba : vertical.data();
+        float* dst = vert ? vertical.data() : out_rgba.data();
+        for (uint32_t y = 0; y < h; ++y)
+            for (uint32_t x = 0; x < w; ++x)
+                filterPixel(terms, src, w, h, vert, x, y, reach, dst + (size_t(y) * w + x) * 4,
+                            none);
+    }
+    stats.samples = uint64_t(pixels) * 2 * 2 * reach;
     return stats;
 } catch (const std::bad_alloc&) {
     return detail::outOfMemory("running the gather reference");
+}
+
+Status probeGather(const GatherImage& image, const ThinLens& lens, const raster::View& view,
+                   const GatherSettings& settings, const GatherScratch& scratch, uint32_t x,
+                   uint32_t y, GatherPixelProbe& out) try {
+    if (Status st = checkAll(image, lens, view, settings); !st.ok())
+        return st;
+    if (x >= image.width || y >= image.height)
+        return Status::error("gather probe: pixel (" + std::to_string(x) + ", " +
+                             std::to_string(y) + ") is outside the " + std::to_string(image.width) +
+                             "x" + std::to_string(image.height) + " image");
+    const Plan p = makePlan(image, settings);
+    const size_t pixels = size_t(p.width) * p.height;
+    const size_t i = size_t(y) * p.width + x;
+    PixelTerms t{};
+    bool bad_depth = false;
+    const bool kept = scratch.radius.size() == pixels && scratch.intensity.size() == pixels &&
+                      scratch.behind.size() == pixels && scratch.leak.size() == pixels &&
+                      scratch.vertical.size() == pixels * 4 &&
+                      scratch.vblock.size() == size_t(p.tiles_x) * p.row_blocks &&
+                      scratch.hblock.size() == size_t(p.height) * p.col_blocks;
+    // The pixel's own terms must be the kept ones: a cheap check that the scratch holds this
+    // frame (§4.1: C = a D + b).
+    if (!kept || !pixelTerms(image, cocAffine(lens, view), settings, i, t, bad_depth) ||
+        t.radius != scratch.radius[i] || t.intensity != scratch.intensity[i])
+        return Status::error("gather probe: the scratch does not hold this frame (run gather() "
+                             "with it on the same image and settings first)");
+
+    out = GatherPixelProbe{};
+    out.x = x;
+    out.y = y;
+    out.coc_px = t.coc;
+    out.radius_px = t.radius;
+    const uint32_t x0 = (x / p.tile) * p.tile;
+    out.vertical_reach =
+        verticalReach(p, settings, scratch.vblock.data(), x / p.tile, (y / kBlock) * kBlock);
+    out.horizontal_reach =
+        horizontalReach(p, settings, scratch.hblock.data(), y, x0, std::min(p.width, x0 + p.tile));
+    out.copied_vertical = out.vertical_reach == 0;
+    out.copied_horizontal = out.horizontal_reach == 0;
+
+    // Records each tap of a pass into `taps`.
+    struct TapRecorder {
+        std::vector<GatherTap>& taps;
+        void tap(uint32_t sx, uint32_t sy, int k, const SampleFactors& f, float w, const float* c) {
+            GatherTap g;
+            g.x = int32_t(sx);
+            g.y = int32_t(sy);
+            g.offset = k;
+            g.weight = w;
+            g.overlap = f.overlap;
+            g.intensity = f.intensity;
+            g.leakage = f.leakage;
+            std::copy_n(c, 4, g.rgba);
+            taps.push_back(g);
+        }
+    };
+    const TermArrays terms{scratch.radius.data(), scratch.intensity.data(), scratch.behind.data(),
+                           scratch.leak.data()};
+    // Pass 1 on the pinhole image, pass 2 on the kept output of pass 1 (§4.2).
+    TapRecorder vrec{out.vertical};
+    filterPixel(terms, image.rgba, p.width, p.height, true, x, y, out.vertical_reach,
+                out.vertical_rgba, vrec);
+    TapRecorder hrec{out.horizontal};
+    filterPixel(terms, scratch.vertical.data(), p.width, p.height, false, x, y,
+                out.horizontal_reach, out.rgba, hrec);
+    return {};
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("probing gather");
 }
 
 } // namespace dof

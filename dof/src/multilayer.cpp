@@ -47,7 +47,6 @@ void axisTaps(uint32_t pixels, float origin, float spacing, uint32_t cells,
     }
 }
 
-// A list being traversed: level `level`, bilinear weight, cursor.
 // A list being traversed: its next fragment, its end, and the bilinear weight.
 struct Cursor {
     const LayerFragment* next = nullptr;
@@ -59,6 +58,7 @@ struct Cursor {
 // 1 - f, then j1 with weight f, each kept only with a weight > 0 and fragments in it.
 struct TapRows {
     uint32_t count = 0;
+    uint32_t cell_row[2] = {};      // j0 or j1
     const uint32_t* starts[2] = {}; // the row's list starts (FragmentLevel::starts)
     const LayerFragment* data[2] = {};
     float weight[2] = {};
@@ -73,6 +73,7 @@ TapRows tapRows(const FragmentLevel& level, const AxisTap& ay) {
     for (int r = 0; r < 2; ++r) {
         if (!(wy[r] > 0.0f) || level.rows[cy[r]].empty())
             continue;
+        t.cell_row[t.count] = cy[r];
         t.starts[t.count] = level.starts.data() + size_t(cy[r]) * (level.width + 1);
         t.data[t.count] = level.rows[cy[r]].data();
         t.weight[t.count] = wy[r];
@@ -84,6 +85,210 @@ TapRows tapRows(const FragmentLevel& level, const AxisTap& ay) {
 constexpr float kOpaque = 1.0f - 1.0f / 1024.0f; // stop once the pixel is this opaque
 
 using Plan = Multilayer::Plan;
+
+// What every pixel's traversal (§6.1) reads, set up once per frame from the kept state: by the
+// render and by probe() alike. Points into the Multilayer it was made from.
+struct TraversalFrame {
+    const FragmentLevel* tlevel[2][kMaxTraversalLevels] = {}; // the levels of T, [near, far]
+    uint32_t n = 0;                                           // T holds levels 0..n
+    uint32_t sides = 1; // 2: the near and far sides read their own aperture levels
+    const Multilayer::Traversal* st = nullptr;
+    const LevelBorders* borders = nullptr;
+
+    uint32_t sideOf(const LevelBorders::Segment& seg) const {
+        return sides == 2 && seg.begin >= st->lens.focus_distance ? 1u : 0u;
+    }
+};
+
+TraversalFrame traversalFrame(const Plan& plan, const std::vector<FragmentLevel>& levels,
+                              const std::vector<FragmentLevel>& apertures,
+                              const LevelBorders& borders, const Multilayer::Traversal& st) {
+    TraversalFrame tf;
+    tf.n = uint32_t(plan.traversal.size()) - 1;
+    FOCAL_CHECK(tf.n + 1 <= kMaxTraversalLevels);
+    tf.sides = st.asymmetric ? 2 : 1;
+    tf.st = &st;
+    tf.borders = &borders;
+    // Near-side aperture levels follow the far side's when the aperture is asymmetric.
+    const size_t shaped_count = plan.apertures.size();
+    for (uint32_t s = 0; s <= tf.n; ++s) {
+        const Plan::Entry& e = plan.traversal[s];
+        tf.tlevel[1][s] = e.aperture ? &apertures[e.level] : &levels[e.level];
+        tf.tlevel[0][s] =
+            e.aperture && st.asymmetric ? &apertures[shaped_count + e.level] : tf.tlevel[1][s];
+    }
+    return tf;
+}
+
+// The rows of cells every level's bilinear taps read on row y of pixels.
+void rowTaps(const TraversalFrame& tf, uint32_t y, TapRows (&rows)[2][kMaxTraversalLevels]) {
+    for (uint32_t side = 0; side < tf.sides; ++side)
+        for (uint32_t s = 0; s <= tf.n; ++s)
+            rows[side][s] = tapRows(*tf.tlevel[side][s], tf.st->ty[s][y]);
+}
+
+// The cursors of one pixel's taps, per side and level of T: working memory a row's task reuses
+// for its pixels (not initialised per pixel: traversePixel sets what it reads).
+struct PixelCursors {
+    Cursor cursors[2][kMaxTraversalLevels][4];
+    uint32_t count[2][kMaxTraversalLevels];
+};
+
+// The render's recorder: records nothing (every call compiles away).
+struct NoRecorder {
+    void tap(uint32_t, uint32_t, uint32_t, uint32_t, uint32_t, const LayerFragment*, float) {}
+    void skip(uint32_t, uint32_t, uint32_t, uint32_t, const LayerFragment&) {}
+    void read(uint32_t, uint32_t, uint32_t, uint32_t, const LayerFragment&, float, float) {}
+    void slice(uint32_t, const LevelBorders::Segment&, float, float, float, const float (&)[2][4],
+               bool, bool, float, float, float) {}
+    void done(float, float) {}
+};
+
+// §6.1 for pixel x of the row whose taps are `rows`: traverse T near to far and blend the slices
+// met front to back into `out` (RGBA, alpha 1); with `level_rgba`, add each level's share at
+// pixel index p. Returns the slices blended. `rec` sees every tap (side, level, tap index, cell,
+// first fragment, bilinear weight), every fragment skipped or read (side, level, tap, segment,
+// fragment[, level weight, share]), every slice and the final coverage.
+template <class Recorder>
+uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTraversalLevels],
+                       PixelCursors& pc, uint32_t x, float* out,
+                       std::vector<std::vector<float>>* level_rgba, size_t p, Recorder& rec) {
+    const Multilayer::Traversal& st = *tf.st;
+    const std::vector<LevelBorders::Segment>& segments = st.segments;
+    // Bilinear taps of every level at the pixel centre, in the order (i0, j0), (i1, j0),
+    // (i0, j1), (i1, j1); taps with weight 0 or an empty list are left out, since they add w·0
+    // to every slice. `present` marks the levels with a tap left, per side.
+    Cursor(&cursors)[2][kMaxTraversalLevels][4] = pc.cursors;
+    uint32_t(&cursor_count)[2][kMaxTraversalLevels] = pc.count;
+    uint64_t present[2] = {0, 0};
+    for (uint32_t side = 0; side < tf.sides; ++side)
+        for (uint32_t s = 0; s <= tf.n; ++s) {
+            const TapRows& tr = rows[side][s];
+            if (tr.count == 0) {
+                cursor_count[side][s] = 0;
+                continue;
+            }
+            const AxisTap ax = st.tx[s][x];
+            const uint32_t cx[2] = {ax.i0, ax.i1};
+            const float wx[2] = {1.0f - ax.f, ax.f};
+            Cursor* cur = cursors[side][s];
+            uint32_t c = 0;
+            for (uint32_t r = 0; r < tr.count; ++r)
+                for (int k = 0; k < 2; ++k) {
+                    const float w = wx[k] * tr.weight[r];
+                    const uint32_t first = tr.starts[r][cx[k]];
+                    const uint32_t last = tr.starts[r][cx[k] + 1];
+                    if (!(w > 0.0f) || last == first)
+                        continue;
+                    cur[c] = {tr.data[r] + first, tr.data[r] + last, w};
+                    rec.tap(side, s, c, cx[k], tr.cell_row[r], cur[c].next, w);
+                    ++c;
+                }
+            cursor_count[side][s] = c;
+            present[side] |= uint64_t(c != 0) << s;
+        }
+    float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
+    float ca_g = 0.0f, ga = 0.0f, last_d = 0.0f;
+    bool first = true;
+    uint64_t slices = 0;
+    for (uint32_t si = 0; si < segments.size(); ++si) {
+        if (ca >= kOpaque)
+            break;
+        const LevelBorders::Segment& seg = segments[si];
+        const uint32_t side = tf.sideOf(seg);
+        if ((present[side] & st.seg_levels[si]) == 0)
+            continue; // nothing to read in this segment
+        Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
+        const uint32_t* count_side = cursor_count[side];
+        const uint32_t lv[2] = {seg.lo, seg.hi};
+        const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
+        while (ca < kOpaque) {
+            // The closest fragment in the segment over both levels' taps, after skipping what
+            // lies in front of the segment (not asked of this level there; a no-op after the
+            // first slice, since cursors only advance).
+            float d0 = seg.end;
+            bool any = false;
+            for (uint32_t c = 0; c < classes; ++c)
+                for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
+                    Cursor& cur = cur_side[lv[c]][k];
+                    while (cur.next != cur.end && cur.next->depth < seg.begin) {
+                        rec.skip(side, lv[c], k, si, *cur.next);
+                        ++cur.next;
+                    }
+                    if (cur.next != cur.end && cur.next->depth < d0)
+                        d0 = cur.next->depth, any = true;
+                }
+            if (!any)
+                break;
+            // One slice: the §5.1 merge across taps and the two levels, weighted by the
+            // bilinear weights and the level interpolation t(d0).
+            const float limit = std::min(d0 * st.scale, st.seg_last[si]);
+            const float t = levelBlend(*tf.borders, st.lens, seg, d0);
+            float part[2][4] = {{0.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
+            for (uint32_t c = 0; c < classes; ++c) {
+                const float level_weight = classes == 1 ? 1.0f : (c == 0 ? 1.0f - t : t);
+                const bool pieces = rows[side][lv[c]].pieces;
+                for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
+                    Cursor& cur = cur_side[lv[c]][k];
+                    float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
+                    for (; cur.next != cur.end && cur.next->depth <= limit; ++cur.next) {
+                        const LayerFragment& f = *cur.next;
+                        const float tr = shareInList(f, pieces, pa);
+                        pr += tr * f.r, pg += tr * f.g, pb += tr * f.b, pa += tr * f.a;
+                        rec.read(side, lv[c], k, si, f, level_weight, tr);
+                    }
+                    const float w = level_weight * cur.weight;
+                    part[c][0] += w * pr, part[c][1] += w * pg, part[c][2] += w * pb;
+                    part[c][3] += w * pa;
+                }
+            }
+            const float sa = part[0][3] + part[1][3];
+            if (!(sa > 0.0f)) {
+                rec.slice(si, seg, d0, limit, t, part, false, false, 0.0f, 0.0f, ca);
+                continue;
+            }
+            ++slices;
+            // Front-to-back blending of the slice (§6.1): additive within a group of slices
+            // (disjoint pieces of one layer, §7), the over operator between groups (layers at
+            // clearly different depths, whose holes the lens sees independently).
+            const bool new_group = first || !(d0 <= last_d * st.group_scale);
+            if (new_group) {
+                ca_g = ca;
+                ga = 0.0f;
+            }
+            first = false;
+            last_d = d0;
+            const float take = std::min(sa, 1.0f - ga);
+            const float k = (1.0f - ca_g) * take / sa;
+            ga += take;
+            cr += k * (part[0][0] + part[1][0]);
+            cg += k * (part[0][1] + part[1][1]);
+            cb += k * (part[0][2] + part[1][2]);
+            ca = ca_g + (1.0f - ca_g) * ga;
+            rec.slice(si, seg, d0, limit, t, part, true, new_group, take, k, ca);
+            if (level_rgba)
+                for (uint32_t c = 0; c < classes; ++c) {
+                    float* o = (*level_rgba)[lv[c]].data() + 4 * p;
+                    for (int i = 0; i < 4; ++i)
+                        o[i] += k * part[c][i];
+                }
+        }
+    }
+    ca = std::min(ca, 1.0f);
+    const float rest = 1.0f - ca;
+    const glm::vec3 background = st.background;
+    out[0] = cr + rest * background.r;
+    out[1] = cg + rest * background.g;
+    out[2] = cb + rest * background.b;
+    out[3] = 1.0f;
+    rec.done(ca, rest);
+    if (level_rgba) {
+        float* bg = (*level_rgba)[tf.n + 1].data() + 4 * p;
+        bg[0] = rest * background.r, bg[1] = rest * background.g;
+        bg[2] = rest * background.b, bg[3] = rest;
+    }
+    return slices;
+}
 
 // r_S of level s of T: the |C| whose aperture variance m2·C² is the level's (§6.1).
 double radius(const Plan& p, size_t s, double m2) {
@@ -238,6 +443,7 @@ raster::Status Multilayer::render(const raster::View& view, const ThinLens& lens
     desc.color_format = settings.color_format;
     desc.depth_format = settings.depth_format;
     desc.on_overflow = raster::OverflowPolicy::Grow;
+    traversal_.ready = false; // the collection replaces lists_
     const auto t0 = std::chrono::steady_clock::now();
     if (raster::Status s = collect(desc, lists_); !s.ok())
         return s;
@@ -265,6 +471,8 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     const uint32_t height = lists.height;
     if (width == 0 || height == 0 || lists.offsets.size() != size_t(width) * height + 1)
         return raster::Status::error("multilayer: empty or malformed fragment lists");
+    Multilayer::Traversal& trav = traversal_;
+    trav.ready = false; // until this frame is complete
 
     // Level 0 (§4): premultiplied colour, view distance.
     auto t0 = std::chrono::steady_clock::now();
@@ -354,19 +562,22 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     for (size_t a = 0; a < apertures_.size(); ++a)
         adoptGeometry(plan.apertures[a % shaped_count], apertures_[a]);
 
-    // The levels of T on each side of the focal plane ([near, far]).
-    const uint32_t n = uint32_t(plan.traversal.size()) - 1;
-    FOCAL_CHECK(n + 1 <= kMaxTraversalLevels);
-    const FragmentLevel* tlevel[2][kMaxTraversalLevels] = {};
-    for (uint32_t s = 0; s <= n; ++s) {
-        const Plan::Entry& e = plan.traversal[s];
-        tlevel[1][s] = e.aperture ? &apertures_[e.level] : &levels_[e.level];
-        tlevel[0][s] =
-            e.aperture && asymmetric ? &apertures_[shaped_count + e.level] : tlevel[1][s];
-    }
+    // The levels of T on each side of the focal plane ([near, far]), and what the traversal
+    // reads besides them (kept for probe()).
+    trav.own_lists = &lists == &lists_;
+    trav.view = view;
+    trav.lens = lens;
+    trav.background = background;
+    trav.scale = 1.0f + settings.epsilon;
+    // Slices join the group of the previous one while within this factor of its depth.
+    trav.group_scale = settings.blend == LayerBlend::Additive ? 1.0f + settings.additive_gap : 0.0f;
+    trav.asymmetric = asymmetric;
+    const TraversalFrame tf = traversalFrame(plan, levels_, apertures_, borders_, trav);
+    const uint32_t n = tf.n;
+    const auto& tlevel = tf.tlevel;
     // T as segments; with an asymmetric aperture the one across the focal plane is split there,
     // so that every slice reads the levels of its own side.
-    std::vector<LevelBorders::Segment>& segments = segments_;
+    std::vector<LevelBorders::Segment>& segments = trav.segments;
     segments.clear();
     for (const LevelBorders::Segment& seg : borders_.segments) {
         if (asymmetric && seg.begin < lens.focus_distance && seg.end > lens.focus_distance) {
@@ -376,13 +587,9 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             segments.push_back(seg);
         }
     }
-    const uint32_t sides = asymmetric ? 2 : 1;
-    const auto sideOf = [&](const LevelBorders::Segment& seg) {
-        return sides == 2 && seg.begin >= lens.focus_distance ? 1u : 0u;
-    };
     // The bilinear taps of every level of T at the pixel centres (§6.1).
-    std::vector<std::vector<AxisTap>>& tx = tx_;
-    std::vector<std::vector<AxisTap>>& ty = ty_;
+    std::vector<std::vector<AxisTap>>& tx = trav.tx;
+    std::vector<std::vector<AxisTap>>& ty = trav.ty;
     if (tx.size() < n + 1) {
         tx.resize(n + 1);
         ty.resize(n + 1);
@@ -399,7 +606,7 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         readRange(tx[level.index], r.x0, r.x1);
         readRange(ty[level.index], r.y0, r.y1);
         for (const LevelBorders::Segment& seg : segments) {
-            const uint32_t side = sideOf(seg);
+            const uint32_t side = tf.sideOf(seg);
             if (tlevel[side][seg.lo] != &level && tlevel[side][seg.hi] != &level)
                 continue;
             if (!r.depths.empty() && r.depths.back().end == seg.begin)
@@ -437,14 +644,10 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     } else {
         out.level_rgba.clear();
     }
-    const float scale = 1.0f + settings.epsilon;
-    // Slices join the group of the previous one while within this factor of its depth.
-    const float group_scale =
-        settings.blend == LayerBlend::Additive ? 1.0f + settings.additive_gap : 0.0f;
     // Per segment of T: the last depth a slice may reach (below its end), and the levels it
     // reads as a bit mask.
-    std::vector<float>& seg_last = seg_last_;
-    std::vector<uint64_t>& seg_levels = seg_levels_;
+    std::vector<float>& seg_last = trav.seg_last;
+    std::vector<uint64_t>& seg_levels = trav.seg_levels;
     seg_last.resize(segments.size());
     seg_levels.resize(segments.size());
     for (size_t i = 0; i < segments.size(); ++i) {
@@ -458,140 +661,20 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         // The rows of cells every level's bilinear taps read on this row of pixels: those with
         // a weight > 0 that hold fragments (the others add w·0 to no slice).
         TapRows rows[2][kMaxTraversalLevels];
-        for (uint32_t side = 0; side < sides; ++side)
-            for (uint32_t s = 0; s <= n; ++s)
-                rows[side][s] = tapRows(*tlevel[side][s], ty[s][y]);
-        Cursor cursors[2][kMaxTraversalLevels][4];
-        uint32_t cursor_count[2][kMaxTraversalLevels];
+        rowTaps(tf, y, rows);
+        PixelCursors cursors;
+        NoRecorder none;
         uint64_t slices = 0; // stored once: neighbouring rows' counts share cache lines
         for (uint32_t x = 0; x < width; ++x) {
             const size_t p = size_t(y) * width + x;
-            // Bilinear taps of every level at the pixel centre, in the order (i0, j0), (i1, j0),
-            // (i0, j1), (i1, j1); taps with weight 0 or an empty list are left out, since they
-            // add w·0 to every slice. `present` marks the levels with a tap left, per side.
-            uint64_t present[2] = {0, 0};
-            for (uint32_t side = 0; side < sides; ++side)
-                for (uint32_t s = 0; s <= n; ++s) {
-                    const TapRows& tr = rows[side][s];
-                    if (tr.count == 0) {
-                        cursor_count[side][s] = 0;
-                        continue;
-                    }
-                    const AxisTap ax = tx[s][x];
-                    const uint32_t cx[2] = {ax.i0, ax.i1};
-                    const float wx[2] = {1.0f - ax.f, ax.f};
-                    Cursor* cur = cursors[side][s];
-                    uint32_t c = 0;
-                    for (uint32_t r = 0; r < tr.count; ++r)
-                        for (int k = 0; k < 2; ++k) {
-                            const float w = wx[k] * tr.weight[r];
-                            const uint32_t first = tr.starts[r][cx[k]];
-                            const uint32_t last = tr.starts[r][cx[k] + 1];
-                            if (!(w > 0.0f) || last == first)
-                                continue;
-                            cur[c++] = {tr.data[r] + first, tr.data[r] + last, w};
-                        }
-                    cursor_count[side][s] = c;
-                    present[side] |= uint64_t(c != 0) << s;
-                }
             {
                 uint32_t count = 0;
                 const LayerFragment* base = levels_[0].list(x, y, count);
                 if (count > 0)
                     out.depth[p] = base[0].depth;
             }
-            float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
-            float ca_g = 0.0f, ga = 0.0f, last_d = 0.0f;
-            bool first = true;
-            for (size_t si = 0; si < segments.size(); ++si) {
-                if (ca >= kOpaque)
-                    break;
-                const LevelBorders::Segment& seg = segments[si];
-                const uint32_t side = sideOf(seg);
-                if ((present[side] & seg_levels[si]) == 0)
-                    continue; // nothing to read in this segment
-                Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
-                const uint32_t* count_side = cursor_count[side];
-                const uint32_t lv[2] = {seg.lo, seg.hi};
-                const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
-                while (ca < kOpaque) {
-                    // The closest fragment in the segment over both levels' taps, after
-                    // skipping what lies in front of the segment (not asked of this level
-                    // there; a no-op after the first slice, since cursors only advance).
-                    float d0 = seg.end;
-                    bool any = false;
-                    for (uint32_t c = 0; c < classes; ++c)
-                        for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
-                            Cursor& cur = cur_side[lv[c]][k];
-                            while (cur.next != cur.end && cur.next->depth < seg.begin)
-                                ++cur.next;
-                            if (cur.next != cur.end && cur.next->depth < d0)
-                                d0 = cur.next->depth, any = true;
-                        }
-                    if (!any)
-                        break;
-                    // One slice: the §5.1 merge across taps and the two levels, weighted by
-                    // the bilinear weights and the level interpolation t(d0).
-                    const float limit = std::min(d0 * scale, seg_last[si]);
-                    const float t = levelBlend(borders_, lens, seg, d0);
-                    float part[2][4] = {{0.0f, 0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
-                    for (uint32_t c = 0; c < classes; ++c) {
-                        const float level_weight = classes == 1 ? 1.0f : (c == 0 ? 1.0f - t : t);
-                        const bool pieces = rows[side][lv[c]].pieces;
-                        for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
-                            Cursor& cur = cur_side[lv[c]][k];
-                            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
-                            for (; cur.next != cur.end && cur.next->depth <= limit; ++cur.next) {
-                                const LayerFragment& f = *cur.next;
-                                const float tr = shareInList(f, pieces, pa);
-                                pr += tr * f.r, pg += tr * f.g, pb += tr * f.b, pa += tr * f.a;
-                            }
-                            const float w = level_weight * cur.weight;
-                            part[c][0] += w * pr, part[c][1] += w * pg, part[c][2] += w * pb;
-                            part[c][3] += w * pa;
-                        }
-                    }
-                    const float sa = part[0][3] + part[1][3];
-                    if (!(sa > 0.0f))
-                        continue;
-                    ++slices;
-                    // Front-to-back blending of the slice (§6.1): additive within a group of
-                    // slices (disjoint pieces of one layer, §7), the over operator between
-                    // groups (layers at clearly different depths, whose holes the lens sees
-                    // independently).
-                    if (first || !(d0 <= last_d * group_scale)) {
-                        ca_g = ca;
-                        ga = 0.0f;
-                    }
-                    first = false;
-                    last_d = d0;
-                    const float take = std::min(sa, 1.0f - ga);
-                    const float k = (1.0f - ca_g) * take / sa;
-                    ga += take;
-                    cr += k * (part[0][0] + part[1][0]);
-                    cg += k * (part[0][1] + part[1][1]);
-                    cb += k * (part[0][2] + part[1][2]);
-                    ca = ca_g + (1.0f - ca_g) * ga;
-                    if (contributions)
-                        for (uint32_t c = 0; c < classes; ++c) {
-                            float* o = out.level_rgba[lv[c]].data() + 4 * p;
-                            for (int i = 0; i < 4; ++i)
-                                o[i] += k * part[c][i];
-                        }
-                }
-            }
-            ca = std::min(ca, 1.0f);
-            const float rest = 1.0f - ca;
-            float* o = out.rgba.data() + 4 * p;
-            o[0] = cr + rest * background.r;
-            o[1] = cg + rest * background.g;
-            o[2] = cb + rest * background.b;
-            o[3] = 1.0f;
-            if (contributions) {
-                float* bg = out.level_rgba[n + 1].data() + 4 * p;
-                bg[0] = rest * background.r, bg[1] = rest * background.g;
-                bg[2] = rest * background.b, bg[3] = rest;
-            }
+            slices += traversePixel(tf, rows, cursors, x, out.rgba.data() + 4 * p,
+                                    contributions ? &out.level_rgba : nullptr, p, none);
         }
         row_slices[y] = slices;
     });
@@ -642,9 +725,131 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
             st.traversal.push_back(ts);
         }
     }
+    trav.ready = true;
     return {};
 } catch (const std::bad_alloc&) {
     return outOfMemory(view);
+}
+
+namespace {
+
+// probe()'s recorder: the taps, reads and slices of one pixel's traversal into `out`.
+struct ProbeRecorder {
+    const TraversalFrame& tf;
+    MultilayerPixelProbe& out;
+    struct Tap {
+        uint32_t x = 0, y = 0;
+        const LayerFragment* first = nullptr;
+        float weight = 0.0f;
+    };
+    Tap taps[2][kMaxTraversalLevels][4] = {};
+    size_t slice_reads = 0; // the first read of the current slice
+
+    void tap(uint32_t side, uint32_t s, uint32_t c, uint32_t cx, uint32_t cy,
+             const LayerFragment* first, float w) {
+        taps[side][s][c] = {cx, cy, first, w};
+    }
+    MultilayerProbeRead readOf(uint32_t side, uint32_t s, uint32_t c, uint32_t si,
+                               const LayerFragment& f) const {
+        const Tap& t = taps[side][s][c];
+        MultilayerProbeRead r;
+        r.level = s;
+        r.kind = tf.tlevel[side][s]->kind;
+        r.side = side;
+        r.slice = uint32_t(&f - t.first);
+        r.x = int32_t(t.x);
+        r.y = int32_t(t.y);
+        r.segment = si;
+        r.blend = uint32_t(out.slices.size());
+        r.depth = f.depth;
+        r.coc_px = cocRadiusPx(tf.st->lens, f.depth);
+        r.tap_weight = t.weight;
+        r.rgba[0] = f.r, r.rgba[1] = f.g, r.rgba[2] = f.b, r.rgba[3] = f.a;
+        return r;
+    }
+    void skip(uint32_t side, uint32_t s, uint32_t c, uint32_t si, const LayerFragment& f) {
+        out.reads.push_back(readOf(side, s, c, si, f));
+    }
+    void read(uint32_t side, uint32_t s, uint32_t c, uint32_t si, const LayerFragment& f,
+              float level_weight, float share) {
+        MultilayerProbeRead r = readOf(side, s, c, si, f);
+        r.accepted = true;
+        r.level_weight = level_weight;
+        r.share = share;
+        out.reads.push_back(r);
+    }
+    void slice(uint32_t si, const LevelBorders::Segment& seg, float d0, float limit, float t,
+               const float (&part)[2][4], bool blended, bool new_group, float take, float k,
+               float coverage) {
+        MultilayerProbeSlice sl;
+        sl.segment = si;
+        sl.lo = seg.lo;
+        sl.hi = seg.hi;
+        sl.depth = d0;
+        sl.limit = limit;
+        sl.t = t;
+        std::copy_n(&part[0][0], 8, &sl.part[0][0]);
+        sl.blended = blended;
+        sl.new_group = new_group;
+        sl.take = take;
+        sl.k = k;
+        sl.coverage = coverage;
+        out.slices.push_back(sl);
+        // The slice's reads join the result with k times their weight in the slice's sums.
+        for (size_t i = slice_reads; i < out.reads.size(); ++i) {
+            MultilayerProbeRead& r = out.reads[i];
+            if (r.accepted)
+                r.weight = k * ((r.level_weight * r.tap_weight) * r.share);
+        }
+        slice_reads = out.reads.size();
+    }
+    void done(float coverage, float rest) {
+        out.coverage = coverage;
+        const glm::vec3 bg = tf.st->background;
+        out.background[0] = rest * bg.r, out.background[1] = rest * bg.g;
+        out.background[2] = rest * bg.b;
+    }
+};
+
+} // namespace
+
+raster::Status Multilayer::probe(uint32_t x, uint32_t y, MultilayerPixelProbe& out) const try {
+    const Traversal& st = traversal_;
+    if (!st.ready || levels_.empty())
+        return raster::Status::error(
+            "multilayer probe: no frame to probe (render one first; the last one failed)");
+    const uint32_t width = levels_[0].width, height = levels_[0].height;
+    if (x >= width || y >= height)
+        return raster::Status::error(
+            "multilayer probe: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+            ") is outside the " + std::to_string(width) + "x" + std::to_string(height) + " image");
+    out = MultilayerPixelProbe{};
+    out.x = x;
+    out.y = y;
+    // The collected list (§4), as stored.
+    if (st.own_lists) {
+        const size_t p = size_t(y) * width + x;
+        for (uint32_t i = lists_.offsets[p]; i < lists_.offsets[p + 1]; ++i) {
+            MultilayerProbeFragment f;
+            f.stored_depth = lists_.depth.load(i);
+            f.depth = raster::distanceFromDepth(st.view, f.stored_depth);
+            f.coc_px = cocRadiusPx(st.lens, f.depth);
+            f.primitive = lists_.primitive[i];
+            const glm::vec4 c = lists_.color.load(i);
+            f.rgba[0] = c.r, f.rgba[1] = c.g, f.rgba[2] = c.b, f.rgba[3] = c.a;
+            out.fragments.push_back(f);
+        }
+    }
+    // §6.1 on the kept levels, through the render's own per-pixel code.
+    const TraversalFrame tf = traversalFrame(plan_, levels_, apertures_, borders_, st);
+    TapRows rows[2][kMaxTraversalLevels];
+    rowTaps(tf, y, rows);
+    PixelCursors cursors;
+    ProbeRecorder rec{tf, out};
+    traversePixel(tf, rows, cursors, x, out.rgba, nullptr, 0, rec);
+    return {};
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("probing multilayer");
 }
 
 } // namespace dof

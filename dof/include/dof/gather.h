@@ -13,7 +13,8 @@
 //   horizontal  the same filter along the rows of the vertical pass's output.
 // Each output pixel is computed by exactly one task, its samples summed in a fixed order, so the
 // bytes do not depend on the thread count or the tile size. Tiles the lens cannot change are
-// copied (see GatherStats); the copy is exact, the same bits as filtering them.
+// copied (see GatherStats); the copy is exact, the same bits as filtering them. probeGather
+// re-runs one pixel's passes on the kept GatherScratch and records every tap.
 #pragma once
 
 #include <dof/lens.h>
@@ -150,5 +151,52 @@ raster::Result<GatherStats> gatherReference(const GatherImage& image, const Thin
                                             const raster::View& view,
                                             const GatherSettings& settings,
                                             std::vector<float>& out_rgba);
+
+// --- Probing a pixel (focal steps / focal probe) ---------------------------------------------
+
+// One sample a pass read for the probed pixel: the §5 pseudo-code's inner-loop iteration, or the
+// centre's own term. weight == (overlap * intensity) * leakage, bit for bit, as the pass
+// computes it (§4.2: W(P) = O(r_p) I(r_p) L(z_p)).
+struct GatherTap {
+    int32_t x = 0, y = 0;   // the sample's pixel (clamped to the image edge, §5)
+    int32_t offset = 0;     // k: its offset along the pass; 0 is the centre, W(C) = I(r_c)
+    float weight = 0.0f;    // W: its weight in the pass's sums
+    float overlap = 0.0f;   // O(r_p) = clamp(r_p - |k|, 0, 1) (§4.2); 1 for the centre
+    float intensity = 0.0f; // I(r_p) = 1 / max(r_p, min_radius)^2 (§4.2)
+    float leakage = 0.0f;   // L(z_p): the centre's min(1, s r_c) if the sample lies behind the
+                            // focal plane (C_p > 0), else 1 (§4.2); 1 for the centre
+    float rgba[4] = {};     // the colour the pass read at the sample (the vertical pass: the
+                            // pinhole image; the horizontal pass: the vertical pass's output)
+};
+
+// What made one output pixel of gather(): the taps of both passes, in the order the pass adds
+// them (centre first, then k = -K..K without 0). Owns its vectors.
+struct GatherPixelProbe {
+    uint32_t x = 0, y = 0;
+    float coc_px = 0.0f;    // signed CoC C of the pixel (Eq. 2, evaluated as a*D + b, §4.1)
+    float radius_px = 0.0f; // r_c = min(|C|, R): the radius the filter uses
+    // The loop bound K of each pass at the pixel (skip_tiles: the largest radius that can reach
+    // its 8-pixel block; else ceil(R) - 1). 0: the pass copied the pixel instead of filtering
+    // (the tap list then holds the centre alone, which gives the same bits as the copy).
+    uint32_t vertical_reach = 0;
+    uint32_t horizontal_reach = 0;
+    bool copied_vertical = false;      // vertical_reach == 0
+    bool copied_horizontal = false;    // horizontal_reach == 0
+    std::vector<GatherTap> vertical;   // pass 1 at (x, y), down the column
+    std::vector<GatherTap> horizontal; // pass 2 at (x, y), along the row of pass 1's output
+    float vertical_rgba[4] = {};       // pass 1's output at (x, y)
+    float rgba[4] = {};                // the final output at (x, y)
+};
+
+// After gather() wrote `out_rgba` with `scratch` (and the same image, lens, view and settings),
+// re-runs pixel (x, y)'s two passes on the kept per-pixel terms and vertical output with the
+// same per-tap code, recording every tap into `out` (which it overwrites; it allocates the tap
+// lists). out.rgba equals out_rgba at (x, y) bit for bit, out.vertical_rgba the kept vertical
+// output. The probe runs the scalar loop, which the SSE2 lanes reproduce bit for bit
+// (GatherSettings::simd). Reads `image` and `scratch`, changes neither. Fails on invalid
+// settings or lens, (x, y) outside the image, or a scratch that does not hold this frame.
+raster::Status probeGather(const GatherImage& image, const ThinLens& lens, const raster::View& view,
+                           const GatherSettings& settings, const GatherScratch& scratch, uint32_t x,
+                           uint32_t y, GatherPixelProbe& out);
 
 } // namespace dof

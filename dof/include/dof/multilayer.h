@@ -3,7 +3,8 @@
 // raster::Renderer::renderFragmentLists); builds the filtered level hierarchy (§5, see
 // dof/fragment_levels.h) and accumulates it per pixel guided by the circle of confusion (§6).
 // Produces a linear RGBA image owned by the caller. A Multilayer object keeps the lists and the
-// levels between frames (no reallocation once warm) and exposes them for stepping and dumps.
+// levels between frames (no reallocation once warm) and exposes them for stepping and dumps;
+// probe() re-runs one pixel's traversal on them and records what it read.
 //
 // Determinism: every cell and every output pixel is computed by one task in a fixed order
 // (merges break depth ties by list index), so the bytes do not depend on the thread count.
@@ -167,6 +168,72 @@ struct MultilayerImage {
     std::vector<std::vector<float>> level_rgba;
 };
 
+// --- Probing a pixel (focal steps / focal probe) ---------------------------------------------
+
+// One fragment of the probed pixel's collected list (§4), as stored: nearest first.
+struct MultilayerProbeFragment {
+    float depth = 0.0f;        // view distance d (raster::distanceFromDepth of the stored D)
+    float stored_depth = 0.0f; // D as stored (camera.h)
+    float coc_px = 0.0f;       // signed C(d) (Eq. 2 in pixels, lens.h)
+    uint32_t primitive = 0;    // submission index of its triangle
+    float rgba[4] = {};        // colour and opacity as stored (not premultiplied)
+};
+
+// One fragment the traversal (§6.1) met for the probed pixel, in the order it met them.
+struct MultilayerProbeRead {
+    uint32_t level = 0; // S: the level of T read (Fig. 7); MultilayerStats::traversal[S]
+    LevelKind kind = LevelKind::Base;
+    uint32_t side = 0;         // 0: the level built for the near side, 1: the far side's (the same
+                               // level unless the aperture is asymmetric under a half turn)
+    uint32_t slice = 0;        // the fragment's entry in its cell's depth-sorted list
+    int32_t x = 0, y = 0;      // the cell at that level (FragmentLevel geometry)
+    uint32_t segment = 0;      // the segment of T (LevelBorders::Segment, split at d_f when the
+                               // aperture is asymmetric) whose cursor met it
+    uint32_t blend = 0;        // the slice it joined (skipped: whose search skipped it; equal
+                               // to slices.size() if none followed): MultilayerPixelProbe::slices
+    bool accepted = false;     // merged into that slice; false: skipped, since it lies in front of
+                               // the segment (that level is not asked for its depth, §6.1)
+    float depth = 0.0f;        // view distance of the (merged) fragment
+    float coc_px = 0.0f;       // signed C(depth)
+    float tap_weight = 0.0f;   // bilinear weight of the cell at the pixel centre
+    float level_weight = 0.0f; // 1 - t(d0) for level lo, t(d0) for hi (§6.1 interpolation)
+    float share = 0.0f;        // its share in its list's blend (shareInList, §5.1)
+    // Its weight in the result: k · tap_weight · level_weight · share, k the slice's blending
+    // factor; weight · rgba sums, over the reads, to the result's colour before the background
+    // (to float rounding: the render sums per list, then per slice).
+    float weight = 0.0f;
+    float rgba[4] = {}; // premultiplied (α·c, α), as the level stores it
+};
+
+// One slice the traversal blended (or found empty): the §5.1 merge of every tap's fragments
+// within [depth, limit] across the segment's levels lo and hi, then §6.1's front-to-back blend.
+struct MultilayerProbeSlice {
+    uint32_t segment = 0;
+    uint32_t lo = 0, hi = 0; // the levels of T the segment reads (hi == lo: one)
+    float depth = 0.0f;      // d0: the closest fragment over both levels' taps
+    float limit = 0.0f;      // min(d0 (1 + ε), just below the segment's end)
+    float t = 0.0f;          // levelBlend: the weight of level hi
+    float part[2][4] = {};   // lo's and hi's premultiplied sums, weighted
+    bool blended = false;    // its opacity was > 0 (else nothing changed)
+    bool new_group = false;  // started a group (LayerBlend): the over operator against before
+    float take = 0.0f;       // the opacity it added to its group: min(α, 1 - group's)
+    float k = 0.0f;          // the factor its premultiplied colour joined the result with
+    float coverage = 0.0f;   // the pixel's opacity after it
+};
+
+// What made one pixel of Multilayer's image. Owns its vectors.
+struct MultilayerPixelProbe {
+    uint32_t x = 0, y = 0;
+    // The pixel's collected list (§4), nearest first; empty when the frame came from
+    // renderFromLists (the lists were the caller's).
+    std::vector<MultilayerProbeFragment> fragments;
+    std::vector<MultilayerProbeRead> reads;   // in traversal order
+    std::vector<MultilayerProbeSlice> slices; // in traversal order
+    float coverage = 0.0f;                    // the opacity the slices reached, up to 1
+    float background[3] = {};                 // (1 - coverage) · the background colour, added last
+    float rgba[4] = {}; // the result at (x, y), bit-equal to MultilayerImage::rgba
+};
+
 // Collects the fragment lists of the view (§4), e.g. raster::Renderer::renderFragmentLists.
 using CollectFn =
     std::function<raster::Status(const raster::FragmentListDesc&, raster::FragmentLists&)>;
@@ -198,6 +265,12 @@ public:
     const std::vector<FragmentLevel>& apertureLevels() const { return apertures_; }
     const LevelBorders& borders() const { return borders_; }
 
+    // After a successful render() or renderFromLists(): re-runs pixel (x, y)'s traversal (§6.1)
+    // on the kept levels with the render's own per-pixel code and a recorder, into `out` (which
+    // it overwrites and allocates). out.rgba equals the rendered pixel bit for bit. Fails when
+    // no frame is kept (none rendered, or the last one failed) or (x, y) is outside it.
+    raster::Status probe(uint32_t x, uint32_t y, MultilayerPixelProbe& out) const;
+
     // The bilinear taps of a level along one axis at a pixel centre: cells i0, i1 and the
     // weight f of i1 (an implementation detail, public for the scratch below).
     struct AxisTap {
@@ -218,6 +291,25 @@ public:
         };
         std::vector<Entry> traversal; // T
         std::vector<double> variance; // V_S of T
+    };
+    // What the traversal of the last frame read besides the levels, T and the border table:
+    // kept so that probe() re-runs a pixel on the same data. An implementation detail, public
+    // for the scratch below.
+    struct Traversal {
+        bool ready = false;     // a frame finished rendering with these
+        bool own_lists = false; // the frame's lists are lists_ (render(), not renderFromLists)
+        raster::View view;
+        ThinLens lens;
+        glm::vec3 background{0.0f};
+        float scale = 1.0f;       // 1 + ε: a slice's merge window (§5.1)
+        float group_scale = 0.0f; // LayerBlend::Additive: 1 + additive_gap, else 0
+        bool asymmetric = false;  // near and far aperture levels built apart
+        // T as segments (split at d_f when asymmetric), each one's last depth and levels.
+        std::vector<LevelBorders::Segment> segments;
+        std::vector<float> seg_last;
+        std::vector<uint64_t> seg_levels;
+        // The bilinear taps of every level of T at the pixel centres, per axis.
+        std::vector<std::vector<AxisTap>> tx, ty;
     };
 
 private:
@@ -240,10 +332,7 @@ private:
     // size and settings allocates nothing.
     Plan plan_;
     std::vector<float> row_min_, row_max_;
-    std::vector<std::vector<AxisTap>> tx_, ty_;
-    std::vector<LevelBorders::Segment> segments_;
-    std::vector<float> seg_last_;
-    std::vector<uint64_t> seg_levels_;
+    Traversal traversal_;
     std::vector<uint64_t> row_slices_;
     LevelReads reads_;
 };
