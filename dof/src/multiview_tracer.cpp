@@ -49,8 +49,9 @@ LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
     return tr.samples->sample(k);
 }
 
-// traceTile's recorders. The render's records nothing: every use of a recorder's members sits
-// under `if constexpr (Rec::kOn)`, so the render's code is that of a tracer without them.
+// traceTile's recorders. The render's, NoRecorder, records nothing: every use of a recorder's
+// members sits under `if constexpr (Rec::kOn)`, so the render's code is that of a tracer without
+// them.
 struct NoRecorder {
     static constexpr bool kOn = false;
     // Where pixel (x, y)'s result goes: the frame's image.
@@ -198,7 +199,7 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
     if (s.jitter == JitterMode::Halton)
         halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
     const uint32_t n = tr.samples->size();
-    const float t_last = tr.segs.back().t1;
+    const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
     cnt.rays += n;
     const bool shared = !tr.first_rays.empty(); // the set's samples, the same for every pixel
     if (shared) {
@@ -215,8 +216,7 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
             ray = RayState{ls, w, cone_offsets ? w + cone_offsets[k] : w};
             ray.t_end = t_last;
         }
-        if (s.offscreen == OffscreenPolicy::Discard &&
-            !rayInside(tr, x, y, ray.w, tr.segs.front().t0)) {
+        if (s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_first)) {
             ++cnt.discarded; // the path starts outside the image
             ray.discarded = true;
             ray.transmit = 0.0f;

@@ -111,10 +111,13 @@ struct MultiviewLayerStep {
     // §4.3 per-ray culling: one N-buffer query on the box of the ray's cells found nothing of
     // the layer there, so no height-field test was run (lossless).
     bool culled = false;
-    bool tested = false;               // the height-field test ran (§4.3)
-    uint32_t false_position_steps = 0; // §4.3 false-position iterations (Traversal::FalsePosition)
-    uint32_t binary_steps = 0;         // §4.3 binary-search steps after the bracketing
-    uint32_t fetches = 0;              // height-field texels read
+    bool tested = false; // the height-field test ran (§4.3)
+    // Traversal::FalsePosition (§4.3): false-position iterations (bound_init's first point
+    // included) and binary-search steps after the bracketing, over the opaque and the
+    // transparent plane's searches.
+    uint32_t false_position_steps = 0;
+    uint32_t binary_steps = 0;
+    uint32_t fetches = 0; // height-field texels read
     MultiviewStepResult result = MultiviewStepResult::Passed;
     float t = 0.0f;           // Hit, Cone: stored D of the hit; MissedCone: where the cone looked
     uint32_t texel = 0;       // Hit, Cone: index of the texel hit (y * width + x)

@@ -27,7 +27,7 @@ struct KeptFrame {
     std::vector<float> rgba;
     dof::MultiviewStats stats;
 
-    // Renders builtin scene `name` at width x height; false when it fails.
+    // Renders builtin scene `name` at width x height with its lens; false when it fails.
     bool render(const char* name, uint32_t width, uint32_t height,
                 const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings) {
         raster::Result<raster::Scene> s = scenes::makeBuiltinScene(name);
@@ -37,6 +37,11 @@ struct KeptFrame {
         view = raster::viewFromCamera(scene.cameras[0], width, height);
         lens = dof::makeThinLens(view, scene.lens->aperture_radius, scene.lens->focus_distance);
         shading.scene = &scene;
+        return renderAgain(samples, settings);
+    }
+
+    // Renders the loaded scene again into the kept buffers (with `lens` as it is now).
+    bool renderAgain(const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings) {
         raster::RenderOptions options;
         const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
             return renderer.render(scene, v, options, f);
@@ -260,18 +265,8 @@ TEST(MultiviewProbe, SkippedFrameGivesThePinholePixel) {
     KeptFrame f;
     ASSERT_TRUE(f.render("demo", 64, 48, samples, s));
     f.lens.aperture_radius = 0.0f;
-    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& fr) {
-        return f.renderer.render(f.scene, v, raster::RenderOptions{}, fr);
-    };
-    const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                  raster::LayeredTarget& t) {
-        return f.renderer.renderLayers(f.scene, v, raster::RenderOptions{}, d, t);
-    };
-    raster::Result<dof::MultiviewStats> r =
-        dof::renderMultiview(f.view, f.lens, samples, s, f.shading, f.scene.background, pin, lay,
-                             f.pool, f.rgba, &f.pinhole, &f.layers, &f.scratch);
-    ASSERT_TRUE(r.ok());
-    ASSERT_TRUE(r->skipped);
+    ASSERT_TRUE(f.renderAgain(samples, s));
+    ASSERT_TRUE(f.stats.skipped);
     dof::MultiviewPixelProbe probe;
     ASSERT_TRUE(f.probe(samples, s, 10, 20, probe).ok());
     EXPECT_TRUE(probe.skipped);
