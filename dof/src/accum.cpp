@@ -2,9 +2,11 @@
 
 #include <dof/accum.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <new>
+#include <string>
 #include <vector>
 
 namespace dof {
@@ -15,6 +17,17 @@ namespace {
 
 double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The index of the pixel's RGBA in a frame's colour.
+size_t colorIndex(const raster::Frame& f, glm::uvec2 p) {
+    return (size_t(p.y) * f.width + p.x) * 4;
+}
+
+// Copies frame f's colour at each probed pixel into the probes' results.
+void probeResults(const raster::Frame& f, std::vector<AccumPixelProbe>& probes) {
+    for (AccumPixelProbe& probe : probes)
+        std::copy_n(f.color.data() + colorIndex(f, {probe.x, probe.y}), 4, probe.rgba);
 }
 
 } // namespace
@@ -47,6 +60,20 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
         return s;
     if (samples.size() == 0)
         return Status::error("accum: the lens sample set is empty");
+    std::vector<AccumPixelProbe>* probes = settings.probes;
+    if (probes) {
+        probes->assign(settings.probe_pixels.size(), AccumPixelProbe{});
+        for (size_t i = 0; i < probes->size(); ++i) {
+            const glm::uvec2 p = settings.probe_pixels[i];
+            if (p.x >= view.width || p.y >= view.height)
+                return Status::error("accum: probe pixel (" + std::to_string(p.x) + ", " +
+                                     std::to_string(p.y) + ") lies outside the " +
+                                     std::to_string(view.width) + "x" +
+                                     std::to_string(view.height) + " image");
+            (*probes)[i].x = p.x, (*probes)[i].y = p.y;
+            (*probes)[i].views.reserve(samples.size());
+        }
+    }
     AccumStats stats;
     using Clock = std::chrono::steady_clock;
 
@@ -71,6 +98,8 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
             stats.skip_reason = buf;
         }
         if (stats.skipped) {
+            if (probes)
+                probeResults(out, *probes);
             if (progress)
                 progress(1, 1);
             return stats;
@@ -102,6 +131,16 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
                 return Status::error("accum: the render callback changed the image size");
             src = &scratch;
         }
+        if (probes)
+            for (AccumPixelProbe& probe : *probes) {
+                const size_t c = colorIndex(*src, {probe.x, probe.y});
+                AccumViewSample& vs = probe.views.emplace_back();
+                vs.lens = ls.position;
+                vs.pixel_shift = shift;
+                vs.weight = ls.weight;
+                std::copy_n(src->color.data() + c, 4, vs.rgba);
+                vs.depth = src->depth.load(c / 4);
+            }
         t0 = Clock::now();
         const double w = double(ls.weight);
         const float* color = src->color.data();
@@ -128,6 +167,8 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
     for (size_t k = 0; k < floats; ++k)
         out.color[k] = float(acc[k] * inv);
     stats.ms_accumulate += msSince(t0);
+    if (probes)
+        probeResults(out, *probes);
     return stats;
 } catch (const std::bad_alloc&) {
     return detail::outOfMemory("rendering accum");

@@ -58,6 +58,27 @@ Status layerDesc(const ThinLens& lens, const DepthRange& range, const MultiviewS
     return {};
 }
 
+// Points the tracer at the frame's inputs (what it reads but does not own).
+void bindTracer(Tracer& tr, const raster::View& view, const ThinLens& lens,
+                const LensSampleSet& samples, const raster::Frame& pinhole,
+                const raster::LayeredTarget& layers, const MultiviewSettings& settings,
+                const ShadingInputs& shading, const MultiviewScratch& scratch) {
+    tr.view = &view;
+    tr.lens = &lens;
+    tr.samples = &samples;
+    tr.layers = &layers;
+    tr.settings = &settings;
+    tr.shading = &shading;
+    tr.scratch = &scratch;
+    tr.pinhole = &pinhole;
+}
+
+Status outsideImage(uint32_t x, uint32_t y, uint32_t width, uint32_t height) {
+    return Status::error("multiview probe: pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                         ") lies outside the " + std::to_string(width) + "x" +
+                         std::to_string(height) + " image");
+}
+
 } // namespace
 
 MultiviewScratch::MultiviewScratch() = default;
@@ -111,17 +132,13 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     stats.budget_limited = spacing.budget_limited;
     stats.layered_bytes = layers.bytes();
 
+    if (settings.debug_rays && (settings.debug_x >= width || settings.debug_y >= height))
+        return outsideImage(settings.debug_x, settings.debug_y, width, height);
     FrameState& fs = frameState(scratch);
+    fs.kept = FrameState::Kept::None;
     Tracer& tr = fs.tracer;
     tr.reset();
-    tr.view = &view;
-    tr.lens = &lens;
-    tr.samples = &samples;
-    tr.layers = &layers;
-    tr.settings = &settings;
-    tr.shading = &shading;
-    tr.scratch = &scratch;
-    tr.pinhole = &pinhole;
+    bindTracer(tr, view, lens, samples, pinhole, layers, settings, shading, scratch);
     tr.width = width;
     tr.height = height;
     tr.background = background;
@@ -227,18 +244,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         TileCounters cnt;
         const uint32_t x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
         const uint32_t x1 = std::min(x0 + ts, width), y1 = std::min(y0 + ts, height);
-        // Skip empty layers, and layers with nothing in reach of the whole tile (one query).
         std::array<uint32_t, raster::kMaxLayers> tile_layers{};
-        uint32_t count = 0;
-        for (uint32_t l = 0; l < m; ++l) {
-            if (tr.segs[l].empty)
-                continue;
-            if (settings.culling && culled(tr, l, x0, x1 - 1, y0, y1 - 1, tr.segs[l].cone_px)) {
-                ++cnt.culled_tile;
-                continue;
-            }
-            tile_layers[count++] = l;
-        }
+        const uint32_t count = tileLayers(tr, x0, x1, y0, y1, tile_layers.data(), cnt);
         trace_tile(tr, x0, x1, y0, y1, tile_layers.data(), count,
                    ray_states.data() + size_t(worker) * ts * ts * samples.size(),
                    pixel_layers.data() + size_t(worker) * ts * ts, rgba.data(), cnt);
@@ -260,6 +267,13 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         stats.pixels_in_focus += c.pixels_in_focus;
     }
     stats.ms_tracing = msSince(t0);
+    fs.kept = FrameState::Kept::Traced;
+    fs.sample_count = samples.size();
+    if (settings.debug_rays) {
+        MultiviewPixelProbe probe;
+        probePixel(tr, settings.debug_x, settings.debug_y, probe);
+        *settings.debug_rays = std::move(probe.rays);
+    }
     return stats;
 } catch (const std::bad_alloc&) {
     return detail::outOfMemory("synthesizing multiview");
@@ -303,6 +317,8 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     }
     if (!skip_reason.empty()) {
         rgba = pinhole.color;
+        if (scratch_io)
+            frameState(*scratch_io).kept = FrameState::Kept::Skipped;
         if (layers_out)
             *layers_out = raster::LayeredTarget{}; // no decomposition was made
         MultiviewStats stats;
@@ -336,6 +352,43 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     return r;
 } catch (const std::bad_alloc&) {
     return detail::outOfMemory("rendering multiview");
+}
+
+Status probeMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
+                      const raster::Frame& pinhole, const raster::LayeredTarget& layers,
+                      const MultiviewSettings& settings, const ShadingInputs& shading,
+                      const MultiviewScratch& scratch, uint32_t x, uint32_t y,
+                      MultiviewPixelProbe& out) try {
+    const FrameState* fs = scratch.frame.get();
+    if (!fs || fs->kept == FrameState::Kept::None)
+        return Status::error("multiview probe: the scratch holds no frame (probe after a "
+                             "renderMultiview or synthesizeMultiview call that used it)");
+    if (x >= view.width || y >= view.height)
+        return outsideImage(x, y, view.width, view.height);
+    if (pinhole.width != view.width || pinhole.height != view.height)
+        return Status::error("multiview probe: the pinhole frame must match the view size");
+    if (fs->kept == FrameState::Kept::Skipped) {
+        // renderMultiview returned the pinhole image.
+        out = MultiviewPixelProbe{};
+        out.x = x, out.y = y;
+        out.skipped = true;
+        std::copy_n(pinhole.color.data() + (size_t(y) * view.width + x) * 4, 4, out.rgba);
+        return {};
+    }
+    const Tracer& kept = fs->tracer;
+    if (view.width != kept.width || view.height != kept.height || layers.width != kept.width ||
+        layers.height != kept.height || layers.layer_count != kept.segs.size() ||
+        samples.size() != fs->sample_count)
+        return Status::error("multiview probe: the view, layers or samples are not the frame's");
+    if (Status st = validate(settings, samples.size()); !st.ok())
+        return st;
+    // The kept tracer read the frame's inputs, which the caller passes again here.
+    Tracer tr = kept;
+    bindTracer(tr, view, lens, samples, pinhole, layers, settings, shading, scratch);
+    probePixel(tr, x, y, out);
+    return {};
+} catch (const std::bad_alloc&) {
+    return detail::outOfMemory("probing a multiview pixel");
 }
 
 uint64_t multiviewMinimumBytes(const MultiviewSettings& settings, uint32_t width, uint32_t height,

@@ -46,6 +46,10 @@ struct FrameState {
     std::vector<RayState> ray_states;      // per worker: one tile's rays
     std::vector<PixelLayers> pixel_layers; // per worker: one tile's pixels
     raster::SurfaceShader shader;          // per-ray shading (§5), prepared again each frame
+    // What the last frame left for probeMultiview: its tracer (Traced) or the pinhole image
+    // (Skipped), and its sample count.
+    enum class Kept : uint8_t { None, Traced, Skipped } kept = Kept::None;
+    uint32_t sample_count = 0;
 };
 
 // Per-layer float depths (empty -> kEmptyDepth) into scratch.depth and transparent_depth, and

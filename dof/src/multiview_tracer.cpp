@@ -49,16 +49,81 @@ LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
     return tr.samples->sample(k);
 }
 
-// The records of pixel (x, y)'s rays in sample order when it is the debug pixel, else null.
-// beginRays sizes them (`size` rays) before anything is recorded; the others pass 0.
-MultiviewRayRecord* debugRecords(const Tracer& tr, uint32_t x, uint32_t y, uint32_t size = 0) {
-    const MultiviewSettings& s = *tr.settings;
-    if (!s.debug_rays || x != s.debug_x || y != s.debug_y)
-        return nullptr;
-    if (size > 0)
-        s.debug_rays->assign(size, MultiviewRayRecord{});
-    return s.debug_rays->data();
-}
+// traceTile's recorders. The render's, NoRecorder, records nothing: every use of a recorder's
+// members sits under `if constexpr (Rec::kOn)`, so the render's code is that of a tracer without
+// them.
+struct NoRecorder {
+    static constexpr bool kOn = false;
+    // Where pixel (x, y)'s result goes: the frame's image.
+    static float* pixelOut(float* rgba, const Tracer& tr, uint32_t x, uint32_t y, bool) {
+        return rgba + (size_t(y) * tr.width + x) * 4;
+    }
+};
+
+// probePixel's: fills a MultiviewPixelProbe (sized before tracing) as the tracer runs.
+struct ProbeRecorder {
+    static constexpr bool kOn = true;
+    MultiviewPixelProbe& probe;
+    PixelLayers pixel_layers;           // the pixel's culling, before rays end layers
+    MultiviewLayerStep* step = nullptr; // the (ray, layer) step being traced
+    uint64_t step_fetches = 0;          // TileCounters::fetches when it began
+    std::array<float, 4> traced_rgba{}; // the traced result of a pixel resolved in focus
+
+    // The pixel's result: probe.rgba is what the frame wrote, from inFocusPixel (traced =
+    // false) or from endPixel; an in-focus pixel's traced rays end in traced_rgba.
+    float* pixelOut(float*, const Tracer&, uint32_t, uint32_t, bool traced) {
+        return traced && probe.in_focus ? traced_rgba.data() : probe.rgba;
+    }
+    void beginStep(uint32_t k, uint32_t l, float t_enter, const TileCounters& cnt) {
+        step = &probe.rays[k].steps.emplace_back();
+        step->layer = l;
+        step->t_enter = t_enter;
+        step_fetches = cnt.fetches;
+    }
+    // Ray k took colour c1 with coverage v1 in the step's layer (result: Hit, Cone, MissedCone).
+    void colour(uint32_t k, MultiviewStepResult result, float t, uint32_t texel, float v1,
+                glm::vec3 c1) {
+        probe.rays[k].layer = int32_t(step->layer);
+        step->result = result;
+        step->t = t;
+        step->texel = texel;
+        step->coverage = v1;
+        step->c1 = c1;
+    }
+    // Ray k of pixel (x, y) as beginRays set it up (ended at once when discarded there).
+    void beginRay(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k, const RayState& ray) {
+        MultiviewRayRecord& r = probe.rays[k];
+        r.lens = ray.lens.position;
+        r.weight = ray.lens.weight;
+        r.t_start = tr.segs.front().t0;
+        r.start_px = pointAt(tr, x, y, ray, r.t_start);
+        if (ray.discarded)
+            r.discarded = true, r.t_end = r.t_start, r.end_px = r.start_px;
+    }
+    // Ray k's end in endPixel: its colour (with the background it sees), where it ended and
+    // whether its path left the image there (`dropped`).
+    void endRay(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k, const RayState& ray,
+                glm::vec3 color, float t_end, bool background, bool dropped) {
+        MultiviewRayRecord& r = probe.rays[k];
+        if (background)
+            r.layer = -1;
+        r.t_end = t_end;
+        r.end_px = pointAt(tr, x, y, ray, t_end);
+        r.discarded = dropped;
+        if (!dropped)
+            r.rgba[0] = color.r, r.rgba[1] = color.g, r.rgba[2] = color.b, r.rgba[3] = 1.0f;
+    }
+    // The image position of pixel (x, y)'s ray at stored depth t (Eq. 2-3).
+    static glm::vec2 pointAt(const Tracer& tr, uint32_t x, uint32_t y, const RayState& ray,
+                             float t) {
+        return glm::vec2(float(x) + 0.5f, float(y) + 0.5f) + tr.cocOf(t) * ray.w;
+    }
+    void endStep(const RayState& ray, const TileCounters& cnt) {
+        step->fetches = uint32_t(cnt.fetches - step_fetches);
+        step->color = ray.color;
+        step->transmit = ray.transmit;
+    }
+};
 
 // Whether pixel (x, y)'s ray with offset w lies in the image at stored depth t.
 bool rayInside(const Tracer& tr, uint32_t x, uint32_t y, glm::vec2 w, float t) {
@@ -121,7 +186,9 @@ bool inFocusPixel(const Tracer& tr, uint32_t x, uint32_t y, const PixelLayers& p
 }
 
 // The start of each of pixel (x, y)'s rays.
-void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCounters& cnt) {
+template <class Rec>
+void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCounters& cnt,
+               Rec& rec) {
     const MultiviewSettings& s = *tr.settings;
     // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
     std::array<float, 4> noise{};
@@ -133,13 +200,11 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
         halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
     const uint32_t n = tr.samples->size();
     const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
-    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
-    MultiviewRayRecord* records = debugRecords(tr, x, y, n);
     cnt.rays += n;
     const bool shared = !tr.first_rays.empty(); // the set's samples, the same for every pixel
     if (shared) {
         std::copy_n(tr.first_rays.data(), n, rays);
-        if (!records && s.offscreen != OffscreenPolicy::Discard)
+        if (!Rec::kOn && s.offscreen != OffscreenPolicy::Discard)
             return;
     }
     const glm::vec2* cone_offsets = tr.cone_offsets.empty() ? nullptr : tr.cone_offsets.data();
@@ -151,20 +216,13 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
             ray = RayState{ls, w, cone_offsets ? w + cone_offsets[k] : w};
             ray.t_end = t_last;
         }
-        MultiviewRayRecord* rec = records ? records + k : nullptr;
-        if (rec) {
-            rec->lens = ray.lens.position;
-            rec->weight = ray.lens.weight;
-            rec->t_start = t_first;
-            rec->start_px = glm::vec2(cx, cy) + tr.cocOf(t_first) * ray.w;
-        }
         if (s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_first)) {
             ++cnt.discarded; // the path starts outside the image
             ray.discarded = true;
             ray.transmit = 0.0f;
-            if (rec)
-                rec->discarded = true, rec->t_end = t_first, rec->end_px = rec->start_px;
         }
+        if constexpr (Rec::kOn)
+            rec.beginRay(tr, x, y, k, ray);
     }
 }
 
@@ -205,17 +263,16 @@ struct PixelLayer {
 
 // Ray k of pixel (pl.x, pl.y) through layer pl.l (§4.3-§4.4): its opaque hit or miss, the
 // layer's transparent plane in front of it, and the cone of either. kPlain: compiled for the
-// usual case, no per-ray shading, no debug record and no transparent plane in the layer (the
-// same arithmetic, without the tests for them).
-template <bool kPlain>
+// usual case, no per-ray shading and no transparent plane in the layer (the same arithmetic,
+// without the tests for them). `rec` records the step (traceTile's recorders).
+template <bool kPlain, class Rec>
 void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ray,
-                MultiviewRayRecord* record, TileCounters& cnt) {
+                TileCounters& cnt, Rec& rec) {
     const MultiviewSettings& s = *tr.settings;
     const raster::View& view = *tr.view;
     const raster::LayeredTarget& lt = *tr.layers;
     const uint32_t x = pl.x, y = pl.y, l = pl.l;
     const bool shade = !kPlain && pl.shade;
-    MultiviewRayRecord* const rec = kPlain ? nullptr : record;
     const float cx = pl.cx, cy = pl.cy;
     const glm::vec2 w = ray.w, wc = ray.wc;
     // Where this ray's hits are shaded from (§5): its lens point, or the lens centre.
@@ -239,8 +296,13 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
     ++cnt.layer_steps;
     const LayerSeg& seg = *pl.seg;
     const float s0 = std::max(seg.t0, ray.t_resume);
-    if (!(s0 < seg.t1))
+    if constexpr (Rec::kOn)
+        rec.beginStep(k, l, s0, cnt);
+    if (!(s0 < seg.t1)) {
+        if constexpr (Rec::kOn)
+            rec.step->result = MultiviewStepResult::Skipped;
         return;
+    }
     // The whole segment's path walked in advance, unless the ray resumes inside it.
     const RayPath* path =
         pl.paths && s0 == seg.t0 ? pl.paths + size_t(k) * pl.path_stride : nullptr;
@@ -256,16 +318,20 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
                       int64_t(y) + box.y1)) {
             ++cnt.culled_ray;
             can_hit = false;
+            if constexpr (Rec::kOn)
+                rec.step->culled = true;
         }
     }
     auto trace = [&](const std::vector<float>& depth, float near, float t_a, float t_b) {
         return s.traversal == Traversal::Scan
                    ? scanHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt)
-                   : traceHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt);
+                   : traceHeightField(tr, depth.data(), near, t_a, t_b, x, y, w, cnt, rec);
     };
     Hit h;
     if (can_hit) {
         ++cnt.layer_tests;
+        if constexpr (Rec::kOn)
+            rec.step->tested = true;
         h = !path ? trace(tr.scratch->depth[l], seg.t0, s0, seg.t1)
             : pl.paths_inside
                 ? scanPathInside(tr, pl.depth, seg.t0, seg.t1, y * tr.width + x, *path, cnt)
@@ -279,9 +345,9 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
     auto addMiss = [&] {
         if (blend(miss->v1, miss->c1))
             ray.t_end = miss->t;
-        if (rec) {
-            rec->layer = int32_t(l);
-            ++rec->missed_cones;
+        if constexpr (Rec::kOn) {
+            rec.colour(k, MultiviewStepResult::MissedCone, miss->t, 0, miss->v1, miss->c1);
+            ++rec.probe.rays[k].missed_cones;
         }
         miss.reset();
     };
@@ -320,8 +386,10 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
             ray.color += ray.transmit * rgb;
             ray.transmit *= 1.0f - std::clamp(m.a, 0.0f, 1.0f);
             ray.t_end = ht.t;
-            if (rec)
-                rec->layer = int32_t(l);
+            if constexpr (Rec::kOn) {
+                rec.probe.rays[k].layer = int32_t(l);
+                rec.step->transparent = true;
+            }
         }
     }
     if (!h.hit) {
@@ -347,15 +415,16 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
         c1 = cone_hit ? shadeFootprint(tr, l, h.texel, h.t, cx + c_hit * wc.x, cy + c_hit * wc.y,
                                        0.5f * tr.lambda * std::fabs(c_hit), shade_from)
                       : shadeHit(tr, l, h.texel, h.t, shade_from);
-    if (rec)
-        rec->layer = int32_t(l);
+    if constexpr (Rec::kOn)
+        rec.colour(k, cone_hit ? MultiviewStepResult::Cone : MultiviewStepResult::Hit, h.t, h.texel,
+                   v1, c1);
     ray.t_end = h.t;
     if (blend(v1, c1))
         return; // the ray ends here (transmit 0)
     // Continue along the centre ray for c2.
     ++cnt.cone_partial;
-    if (rec)
-        ++rec->partial_hits;
+    if constexpr (Rec::kOn)
+        ++rec.probe.rays[k].partial_hits;
     // Resume a thousandth of the segment behind the slab, and at least one float step: stored
     // depth D = -n/d has the scale of n/d (camera.h), so an absolute nudge would skip whole
     // scenes under a tiny near plane.
@@ -364,16 +433,15 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
 
 // The end of pixel (x, y)'s rays: the background behind them, the paths that left the image
 // (Discard), and the weighted mean in sample order.
+template <class Rec>
 void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, float* out,
-              TileCounters& cnt) {
+              TileCounters& cnt, Rec& rec) {
     const MultiviewSettings& s = *tr.settings;
-    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
     const float t_last = tr.segs.back().t1;
     double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
-    MultiviewRayRecord* records = debugRecords(tr, x, y);
     const uint32_t n = tr.samples->size();
     // No ray is recorded or discarded (the usual case): the weighted mean alone, as below.
-    const bool plain = !records && s.offscreen != OffscreenPolicy::Discard;
+    const bool plain = !Rec::kOn && s.offscreen != OffscreenPolicy::Discard;
     for (uint32_t k = 0; plain && k < n; ++k) {
         const RayState& ray = rays[k];
         glm::vec3 color = ray.color;
@@ -393,22 +461,18 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
             continue;
         glm::vec3 color = ray.color;
         float t_end = ray.t_end;
-        MultiviewRayRecord* rec = records ? records + k : nullptr;
-        if (ray.transmit > 0.0f) {
+        const bool background = ray.transmit > 0.0f;
+        if (background) {
             ++cnt.background;
             color += ray.transmit * tr.background;
             t_end = t_last;
-            if (rec)
-                rec->layer = -1;
         }
-        if (rec) {
-            rec->t_end = t_end;
-            rec->end_px = glm::vec2(cx, cy) + tr.cocOf(t_end) * ray.w;
-        }
-        if (s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_end)) {
+        const bool dropped =
+            s.offscreen == OffscreenPolicy::Discard && !rayInside(tr, x, y, ray.w, t_end);
+        if constexpr (Rec::kOn)
+            rec.endRay(tr, x, y, k, ray, color, t_end, background, dropped);
+        if (dropped) {
             ++cnt.discarded; // the path to the hit leaves the image
-            if (rec)
-                rec->discarded = true;
             continue;
         }
         const double wt = double(ray.lens.weight);
@@ -435,9 +499,12 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
 // stay in the cache while they are read (pixel by pixel, all layers of a tile do not fit in it).
 // Each ray still visits its layers front to back with the same arithmetic, so the bytes are
 // those of tracing each pixel's rays to their ends in turn. `rays` holds (x1-x0)(y1-y0)N states.
+// `rec` records what happens (NoRecorder: nothing); a recorder traces the rays of a pixel in
+// focus too, after inFocusPixel has given its result.
+template <class Rec>
 void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
                const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
-               PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
+               PixelLayers* pixel_layers, float* rgba, TileCounters& cnt, Rec& rec) {
     const uint32_t n = tr.samples->size();
     const uint32_t tw = x1 - x0;
     std::array<LayerCulls, raster::kMaxLayers> culls;
@@ -449,13 +516,19 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
             const size_t p = size_t(y - y0) * tw + (x - x0);
             PixelLayers& pl = pixel_layers[p];
             pl = pixelLayers(tr, x, y, tile_layers, tile_layer_count, culls.data(), cnt);
-            if (tr.in_focus && !debugRecords(tr, x, y) &&
-                inFocusPixel(tr, x, y, pl, rgba + (size_t(y) * tr.width + x) * 4, cnt)) {
-                pl.active = 0;
-                pl.resolved = true;
-                continue;
+            if constexpr (Rec::kOn)
+                rec.pixel_layers = pl;
+            if (tr.in_focus &&
+                inFocusPixel(tr, x, y, pl, rec.pixelOut(rgba, tr, x, y, false), cnt)) {
+                if constexpr (Rec::kOn) {
+                    rec.probe.in_focus = true;
+                } else {
+                    pl.active = 0;
+                    pl.resolved = true;
+                    continue;
+                }
             }
-            beginRays(tr, x, y, rays + p * n, cnt);
+            beginRays(tr, x, y, rays + p * n, cnt, rec);
         }
     PixelLayer pxl;
     for (uint32_t i = 0; i < tile_layer_count; ++i) {
@@ -468,15 +541,16 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                     continue;
                 pxl.setPixel(tr, x, y, (pixel_layers[p].hittable >> l) & 1);
                 RayState* pr = rays + p * n;
-                MultiviewRayRecord* recs = debugRecords(tr, x, y);
-                const bool plain = !pxl.shade && !recs && !pxl.seg->transparent;
+                const bool plain = !pxl.shade && !pxl.seg->transparent;
                 uint32_t live = 0;
                 for (uint32_t k = 0; k < n; ++k)
                     if (pr[k].transmit > 0.0f) {
                         if (plain)
-                            traceLayer<true>(tr, pxl, k, pr[k], nullptr, cnt);
+                            traceLayer<true>(tr, pxl, k, pr[k], cnt, rec);
                         else
-                            traceLayer<false>(tr, pxl, k, pr[k], recs ? recs + k : nullptr, cnt);
+                            traceLayer<false>(tr, pxl, k, pr[k], cnt, rec);
+                        if constexpr (Rec::kOn)
+                            rec.endStep(pr[k], cnt);
                         live += pr[k].transmit > 0.0f ? 1 : 0;
                     }
                 if (live == 0)
@@ -487,7 +561,7 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
         for (uint32_t x = x0; x < x1; ++x) {
             const size_t p = size_t(y - y0) * tw + (x - x0);
             if (!pixel_layers[p].resolved)
-                endPixel(tr, x, y, rays + p * n, rgba + (size_t(y) * tr.width + x) * 4, cnt);
+                endPixel(tr, x, y, rays + p * n, rec.pixelOut(rgba, tr, x, y, true), cnt, rec);
         }
 }
 
@@ -507,7 +581,9 @@ __attribute__((flatten)) void
 traceTileBaseline(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
                   const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
                   PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
-    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt);
+    NoRecorder rec;
+    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt,
+              rec);
 }
 
 #ifdef FOCAL_MULTIVIEW_AVX2
@@ -515,7 +591,9 @@ __attribute__((flatten, target("avx2,no-fma"))) void
 traceTileAvx2(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
               const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
               PixelLayers* pixel_layers, float* rgba, TileCounters& cnt) {
-    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt);
+    NoRecorder rec;
+    traceTile(tr, x0, x1, y0, y1, tile_layers, tile_layer_count, rays, pixel_layers, rgba, cnt,
+              rec);
 }
 #endif
 
@@ -526,6 +604,53 @@ bool culled(const Tracer& tr, uint32_t l, uint32_t x0, uint32_t x1, uint32_t y0,
     const float r = tr.segs[l].reach_px + margin;
     const int64_t lo = int64_t(std::floor(0.5f - r)), hi = int64_t(std::floor(0.5f + r));
     return boxCulled(tr, l, int64_t(x0) + lo, int64_t(x1) + hi, int64_t(y0) + lo, int64_t(y1) + hi);
+}
+
+uint32_t tileLayers(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+                    uint32_t* out, TileCounters& cnt) {
+    uint32_t count = 0;
+    for (uint32_t l = 0; l < tr.segs.size(); ++l) {
+        if (tr.segs[l].empty)
+            continue;
+        if (tr.settings->culling && culled(tr, l, x0, x1 - 1, y0, y1 - 1, tr.segs[l].cone_px)) {
+            ++cnt.culled_tile;
+            continue;
+        }
+        out[count++] = l;
+    }
+    return count;
+}
+
+void probePixel(const Tracer& tr, uint32_t x, uint32_t y, MultiviewPixelProbe& out) {
+    const uint32_t n = tr.samples->size(), m = uint32_t(tr.segs.size());
+    out = MultiviewPixelProbe{};
+    out.x = x, out.y = y;
+    out.rays.resize(n);
+    // The frame's tile around the pixel and its layers (the same per-tile culling).
+    const uint32_t ts = tr.settings->tile_size;
+    const uint32_t x0 = x / ts * ts, y0 = y / ts * ts;
+    TileCounters cnt;
+    std::array<uint32_t, raster::kMaxLayers> tile_layers{};
+    const uint32_t count = tileLayers(tr, x0, std::min(x0 + ts, tr.width), y0,
+                                      std::min(y0 + ts, tr.height), tile_layers.data(), cnt);
+    // The pixel alone, as its tile traces it (each pixel's rays are independent of the others').
+    std::vector<RayState> rays(n);
+    PixelLayers pixel_layers;
+    ProbeRecorder rec{out, {}, nullptr, 0, {}};
+    traceTile(tr, x, x + 1, y, y + 1, tile_layers.data(), count, rays.data(), &pixel_layers,
+              nullptr, cnt, rec);
+    out.layers.resize(m);
+    for (uint32_t l = 0; l < m; ++l) {
+        const PixelLayers& pl = rec.pixel_layers;
+        const uint64_t bit = uint64_t(1) << l;
+        out.layers[l] = tr.segs[l].empty ? MultiviewLayerCull::Empty
+                        : std::find(tile_layers.data(), tile_layers.data() + count, l) ==
+                                tile_layers.data() + count
+                            ? MultiviewLayerCull::Tile
+                        : !(pl.active & bit)   ? MultiviewLayerCull::Pixel
+                        : !(pl.hittable & bit) ? MultiviewLayerCull::ConesOnly
+                                               : MultiviewLayerCull::None;
+    }
 }
 
 TraceTileFn traceTileFor(bool simd) {

@@ -273,6 +273,16 @@ using TraceTileFn = void (*)(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_
                              PixelLayers* pixel_layers, float* rgba, TileCounters& cnt);
 TraceTileFn traceTileFor(bool simd);
 
+// The layers the rays of output tile [x0, x1) x [y0, y1) visit, front to back, into `out`
+// (raster::kMaxLayers entries), and their count: the non-empty layers, less those with nothing
+// in reach of the whole tile (one N-buffer query each, §4.3; counted in cnt.culled_tile).
+uint32_t tileLayers(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+                    uint32_t* out, TileCounters& cnt);
+
+// probeMultiview's tracing (pixel (x, y) inside the image): the pixel's tile layers and its
+// rays traced by the baseline traceTile with a recorder into `out`.
+void probePixel(const Tracer& tr, uint32_t x, uint32_t y, MultiviewPixelProbe& out);
+
 // Whether layer l has no texel within `margin` pixels of what the rays of the pixels
 // [x0, x1] x [y0, y1] cross: a ray stays within reach_px of its pixel centre in the layer, so it
 // reads texel offsets within [floor(0.5 - reach), floor(0.5 + reach)] of its pixel (PathCell).

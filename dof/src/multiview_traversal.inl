@@ -13,9 +13,10 @@ namespace {
 // §4.3 "Ray Traversal": the lens ray's segment [s0, s1] in one height field (`depth`, a layer's
 // stored D per texel) by the method of false position followed by a binary search. The ray's
 // image position at depth t is p + C(t) * w (Eq. 2-3, lens.h), w = (-v.x, v.y), kept relative to
-// pixel (x, y) as Tracer::offsetOf.
+// pixel (x, y) as Tracer::offsetOf. `rec` counts the steps (multiview_tracer.cpp's recorders).
+template <class Rec>
 Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float s0, float s1,
-                     uint32_t x, uint32_t y, glm::vec2 w, TileCounters& cnt) {
+                     uint32_t x, uint32_t y, glm::vec2 w, TileCounters& cnt, Rec& rec) {
     struct Sample {
         float h; // stored D of the texel, or kEmptyDepth
         uint32_t texel;
@@ -55,6 +56,8 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
         // is empty are the two end lookups made.
         fa = s0 - s1, fb = s1 - s0;
         const float ti = 0.5f * (s0 + s1);
+        if constexpr (Rec::kOn)
+            ++rec.step->false_position_steps;
         const Sample si = fetch(ti);
         if (si.covered) {
             const float fi = fInterior(ti, si);
@@ -80,6 +83,8 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
             const float ti = ta + (tb - ta) * (-fa / denom);
             if (!(ti > ta && ti < tb))
                 break;
+            if constexpr (Rec::kOn)
+                ++rec.step->false_position_steps;
             const Sample si = fetch(ti);
             const float fi = fInterior(ti, si);
             if (fi >= 0.0f) { // the surface is before I: the crossing lies in [ta, ti]
@@ -94,6 +99,8 @@ Hit traceHeightField(const Tracer& tr, const float* depth, float seg_near, float
         const float tm = 0.5f * (ta + tb);
         if (!(tm > ta && tm < tb))
             break;
+        if constexpr (Rec::kOn)
+            ++rec.step->binary_steps;
         const Sample sm = fetch(tm);
         const float fm = fInterior(tm, sm);
         if (fm >= 0.0f)

@@ -17,6 +17,8 @@
 #include <raster/status.h>
 #include <raster/task_pool.h>
 
+#include <glm/vec2.hpp>
+
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -30,10 +32,37 @@ using RenderFn = std::function<raster::Status(const raster::View&, raster::Frame
 // Called after each view with (views done, views total); may be empty.
 using ProgressFn = std::function<void(uint32_t, uint32_t)>;
 
+// One lens view's sample of a probed pixel (AccumSettings::probes): what the view rendered
+// there and how it enters the mean (Haeberli & Akeley 1990; Lee et al. 2009 §3).
+struct AccumViewSample {
+    glm::vec2 lens{0};        // the lens sample (lens units): the eye at eye + E (x right + y up)
+    glm::vec2 pixel_shift{0}; // the view's sub-pixel shift (pixelJitter; 0 without pixel_jitter)
+    float weight = 0.0f;      // the sample's weight in the mean
+    float rgba[4] = {};       // the view's linear colour at the pixel
+    float depth = 0.0f;       // the view's stored depth D there (camera.h; kFarDepth: empty)
+};
+
+// A probed pixel of the frame: its views in sample (accumulation) order and the result.
+struct AccumPixelProbe {
+    uint32_t x = 0, y = 0;
+    // One per lens view, in the order they were added; empty when the frame was skipped
+    // (AccumStats::skipped: the pixel is the pinhole's).
+    std::vector<AccumViewSample> views;
+    // The accumulated result, bit-equal to the frame's: sum_i double(weight_i) double(rgba_i) in
+    // view order, times 1 / sum_i double(weight_i), rounded to float.
+    float rgba[4] = {};
+};
+
 struct AccumSettings {
     // Also jitter the sub-pixel position per view (View::pixel_shift, Halton bases 5 and 7,
     // centred): a box filter over each pixel. Off: pixels are point-sampled at their centres.
     bool pixel_jitter = false;
+    // Probing (not in accumParams; the caller's memory): when `probes` is set, renderAccum fills
+    // it with one AccumPixelProbe per pixel of `probe_pixels`, in that order, recording each
+    // view's sample as the view is added (no effect on the image). A pixel outside the image
+    // fails the call before anything is rendered. Null: nothing recorded or allocated.
+    std::span<const glm::uvec2> probe_pixels;
+    std::vector<AccumPixelProbe>* probes = nullptr;
 };
 
 // The parameters of AccumSettings (settings_table.h).

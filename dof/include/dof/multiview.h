@@ -94,8 +94,46 @@ struct EnvironmentMap {
     float intensity = 1.0f;
 };
 
-// One lens ray of pixel (MultiviewSettings::debug_x, debug_y), recorded for pictures (the ray is
-// the straight line p + C(t) w in (x, y, D), §4.3): where it starts and ends, and what it hit.
+// What a lens ray met in one layer it visited (traceLayer; layers culled for the whole pixel
+// are not visited, MultiviewPixelProbe::layers).
+enum class MultiviewStepResult : uint8_t {
+    Skipped,    // it resumes behind a partially covered cone past this segment (§4.4): no test
+    Passed,     // no hit, and no cone of the miss saw anything
+    Hit,        // hit a texel and took its colour (sharp: cones off, or lambda |C(d)| <= 1)
+    Cone,       // hit, coloured by its cone (§4.4): coverage v1 and mean colour c1 of the mipmap
+    MissedCone, // no hit; the cone of the miss saw coverage v1 > 0 (cone_misses)
+};
+
+// One (ray, layer) step of traceLayer (§4.3-§4.4), in the order the ray met the layers.
+struct MultiviewLayerStep {
+    uint32_t layer = 0;
+    float t_enter = 0.0f; // stored D where the ray enters the segment (its start or t_resume)
+    // §4.3 per-ray culling: one N-buffer query on the box of the ray's cells found nothing of
+    // the layer there, so no height-field test was run (lossless).
+    bool culled = false;
+    bool tested = false; // the height-field test ran (§4.3)
+    // Traversal::FalsePosition (§4.3): false-position iterations (bound_init's first point
+    // included) and binary-search steps after the bracketing, over the opaque and the
+    // transparent plane's searches.
+    uint32_t false_position_steps = 0;
+    uint32_t binary_steps = 0;
+    uint32_t fetches = 0; // height-field texels read
+    MultiviewStepResult result = MultiviewStepResult::Passed;
+    float t = 0.0f;           // Hit, Cone: stored D of the hit; MissedCone: where the cone looked
+    uint32_t texel = 0;       // Hit, Cone: index of the texel hit (y * width + x)
+    float coverage = 0.0f;    // Hit: 1; Cone, MissedCone: the cone's coverage v1 (§4.4)
+    glm::vec3 c1{0.0f};       // Hit: the texel's colour; Cone, MissedCone: the cone's c1 (§4.4)
+    bool transparent = false; // the layer's transparent plane was hit in front (BLEND surfaces)
+    // The ray after the step: its colour so far and the transmittance (1 - v1) products (§4.4)
+    // left for the layers behind (0: the ray has ended).
+    glm::vec3 color{0.0f};
+    float transmit = 0.0f;
+};
+
+// One lens ray of a pixel (probeMultiview): the straight line p + C(t) w in (x, y, D) of §4.3,
+// where it starts and ends, each layer it visited and what it gave the pixel. How it ended:
+// discarded; else layer >= 0: blocked there (by a hit, or by cones whose coverage, §4.4, used
+// it up); else layer -1: it passed every layer and sees the background with what it had left.
 struct MultiviewRayRecord {
     glm::vec2 lens{0.0f};      // jittered lens position (lens units, §4.5)
     float weight = 0.0f;       // the sample's weight
@@ -106,7 +144,33 @@ struct MultiviewRayRecord {
     int32_t layer = -1;        // layer of the hit that ended it; -1: background
     uint32_t partial_hits = 0; // cone hits with coverage < 1 passed through (§4.4)
     uint32_t missed_cones = 0; // layers missed whose cone saw something (cone_misses)
-    bool discarded = false;    // left the image (OffscreenPolicy::Discard)
+    bool discarded = false;    // left the image (OffscreenPolicy::Discard): not in the mean
+    std::vector<MultiviewLayerStep> steps; // layer by layer, front to back
+    // What the ray adds to the pixel's weighted mean (§4.3): its colour, the background seen
+    // through what it had left, alpha 1; all 0 when discarded.
+    float rgba[4] = {};
+};
+
+// Why a layer was or was not visited by a pixel's rays (§4.3 early culling with N-buffers).
+enum class MultiviewLayerCull : uint8_t {
+    Empty,     // the layer holds no fragment
+    Tile,      // one N-buffer query for the pixel's output tile found nothing in reach
+    Pixel,     // the pixel's query found nothing in reach of its rays or of their cones
+    ConesOnly, // the rays cannot hit it, only their missed cones see it (cone_misses)
+    None,      // visited by every ray that was still going
+};
+
+// Everything one output pixel's tracing did (probeMultiview).
+struct MultiviewPixelProbe {
+    uint32_t x = 0, y = 0;
+    // The frame was not traced (MultiviewStats::skipped): the pixel is the pinhole's, no rays.
+    bool skipped = false;
+    // The frame resolved this pixel in focus without tracing its rays (every ray hits its own
+    // texel, §4.3); the rays below are traced anyway and give the same bytes.
+    bool in_focus = false;
+    std::vector<MultiviewLayerCull> layers; // per layer index
+    std::vector<MultiviewRayRecord> rays;   // every lens ray of the pixel, in sample order
+    float rgba[4] = {};                     // the pixel's result, bit-equal to what the frame wrote
 };
 
 struct MultiviewSettings {
@@ -153,8 +217,8 @@ struct MultiviewSettings {
     // For JitterMode::Halton: 2N samples of the same pattern family and aperture as the main set.
     const LensSampleSet* sequence_2n = nullptr;
     uint32_t tile_size = 16; // output tile (the unit of parallel work and of tile culling)
-    // Debugging: when debug_rays is set, the rays of pixel (debug_x, debug_y) are recorded there
-    // in sample order (written only by the task that owns the pixel; no effect on the image).
+    // Debugging: when debug_rays is set, the frame ends with probeMultiview of pixel
+    // (debug_x, debug_y), whose rays are stored there (no effect on the image).
     uint32_t debug_x = 0, debug_y = 0;
     std::vector<MultiviewRayRecord>* debug_rays = nullptr;
 };
@@ -274,6 +338,20 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
                     const LayerSpacing& spacing, const MultiviewSettings& settings,
                     const ShadingInputs& shading, glm::vec3 background, raster::TaskPool& pool,
                     MultiviewScratch& scratch, std::vector<float>& rgba);
+
+// The probe of pixel (x, y) of the last frame synthesized with `scratch` (§4.3-§4.5): its
+// lens rays traced again with the tracer's own functions (the baseline build, which gives the
+// AVX2 build's bytes) and a recorder, on the per-frame constants, N-buffers and mipmaps kept in
+// `scratch`. The other arguments must be those of that frame, unchanged since (the
+// MultiviewSettings as the frame read them, with seed and sequence_2n). Writes `out` (its
+// vectors allocated here); the scratch is only read. Fails when the pixel lies outside the
+// image, when `scratch` holds no frame, or when the arguments do not match it.
+raster::Status probeMultiview(const raster::View& view, const ThinLens& lens,
+                              const LensSampleSet& samples, const raster::Frame& pinhole,
+                              const raster::LayeredTarget& layers,
+                              const MultiviewSettings& settings, const ShadingInputs& shading,
+                              const MultiviewScratch& scratch, uint32_t x, uint32_t y,
+                              MultiviewPixelProbe& out);
 
 using PinholeFn = std::function<raster::Status(const raster::View&, raster::Frame&)>;
 using LayersFn = std::function<raster::Status(const raster::View&, const raster::LayeredTargetDesc&,
