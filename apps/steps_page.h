@@ -10,11 +10,11 @@
 namespace focal {
 
 struct StepsPageFile {
-    const char* name;          // file name inside the steps folder, e.g. "index.html"
-    std::string_view content;  // the file's bytes (UTF-8 text)
+    const char* name;         // file name inside the steps folder, e.g. "index.html"
+    std::string_view content; // the file's bytes (UTF-8 text)
 };
 
 // The page's files, in the order index.html, steps.css, steps.js. Valid for the program's lifetime.
 std::span<const StepsPageFile> stepsPageFiles();
 
-}  // namespace focal
+} // namespace focal

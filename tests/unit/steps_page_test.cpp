@@ -28,4 +28,4 @@ TEST(StepsPage, EmbedsTheThreePageFilesUnchanged) {
     }
 }
 
-}  // namespace
+} // namespace
