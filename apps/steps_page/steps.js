@@ -232,6 +232,7 @@
     img.addEventListener('error', () => {
       img.setAttribute('data-loaded', 'error');
       img.hidden = true;
+      svg.setAttribute('hidden', '');
       const cmd = typeof state.data.command === 'string' ? ` Re-run: ${state.data.command}` : '';
       root.append(el('div', { class: 'image-error',
         text: `Could not load ${record.file} (missing, or not an image). The folder may be incomplete.${cmd}` }));
@@ -376,8 +377,8 @@
     if (pos < 0 || pos >= state.stages.length) return;
     state.stagePos = pos;
     const stage = state.stages[pos];
-    for (const li of document.querySelectorAll('#stage-list li[data-stage-id]')) {
-      const on = li.getAttribute('data-stage-id') === stage.id && li === stageItem(pos);
+    document.querySelectorAll('#stage-list li[data-stage-id]').forEach((li, k) => {
+      const on = k === pos;
       li.classList.toggle('selected', on);
       if (on) {
         li.setAttribute('aria-current', 'step');
@@ -385,7 +386,7 @@
       } else {
         li.removeAttribute('aria-current');
       }
-    }
+    });
     $('stage-view').setAttribute('data-stage-id', stage.id);
     $('stage-title').textContent = stage.title;
     $('stage-paper').textContent = stage.paper;
@@ -398,8 +399,6 @@
     guard(`stage ${stage.id}: plots`, () => renderPlots(stage));
     redrawAll();
   }
-
-  const stageItem = (pos) => document.querySelectorAll('#stage-list li[data-stage-id]')[pos];
 
   function renderCounts(counts) {
     const table = $('stage-counts');
@@ -659,6 +658,7 @@
     box.classList.toggle('inexact', !exact);
     box.textContent = exact ? '' :
       `You clicked (${c.x}, ${c.y}), which was not probed; this is the nearest probed pixel.`;
+    $('probe-command-label').textContent = exact ? 'the same from the command line:' : 'probe the clicked pixel:';
     const cmd = fillProbeCommand(c ? c.x : probe.x, c ? c.y : probe.y);
     $('probe-command').textContent = cmd || '(this folder gives no probe_command)';
   }
