@@ -562,10 +562,42 @@
       }
       box.append(fig);
     }
+    syncScrolling(Array.from(box.querySelectorAll('.viewport')));
     const metrics = [isNum(c.psnr_db) ? `PSNR ${fmt(c.psnr_db)} dB` : null,
                      isNum(c.ssim) ? `SSIM ${fmt(c.ssim)}` : null].filter(Boolean).join(', ');
     $('compare-caption').textContent = [metrics, typeof c.caption === 'string' ? c.caption : '']
       .filter(Boolean).join(' — ');
+  }
+
+  // Scrolling one compare view scrolls the others to the same place.
+  function syncScrolling(views) {
+    let syncing = false;
+    for (const v of views) {
+      v.addEventListener('scroll', () => {
+        if (syncing) return;
+        syncing = true;
+        for (const w of views) {
+          if (w !== v) {
+            w.scrollLeft = v.scrollLeft;
+            w.scrollTop = v.scrollTop;
+          }
+        }
+        syncing = false;
+      });
+    }
+  }
+
+  // Scrolls a stack's viewport so the frame pixel p is in view (centred when it was not).
+  function revealPixel(stack, p) {
+    const view = stack.root.parentElement;
+    if (!view || !view.classList.contains('viewport')) return;
+    const z = state.zoom;
+    const x = (p.x + 0.5) * z, y = (p.y + 0.5) * z;
+    const visible = x >= view.scrollLeft && x < view.scrollLeft + view.clientWidth &&
+                    y >= view.scrollTop && y < view.scrollTop + view.clientHeight;
+    if (visible) return;
+    view.scrollLeft = x - view.clientWidth / 2;
+    view.scrollTop = y - view.clientHeight / 2;
   }
 
   // ---- Probes ----
@@ -595,6 +627,7 @@
     state.clicked = clicked || null;
     guard('probe', renderProbe);
     redrawAll();
+    for (const stack of state.stacks) revealPixel(stack, state.probes[pos]);
   }
 
   function fillProbeCommand(x, y) {
