@@ -416,14 +416,16 @@
     stage.images.forEach((rec, k) => {
       const b = el('button', { type: 'button', 'data-image-index': String(k), text: rec.name });
       if (k === current) b.classList.add('selected');
-      b.addEventListener('click', () => {
-        state.imageChoice[stage.id] = k;
-        renderImagePicker(stage);
-        renderStageImage(stage);
-        redrawAll();
-      });
+      b.addEventListener('click', () => showImage(stage, k));
       picker.append(b);
     });
+  }
+
+  function showImage(stage, k) {
+    state.imageChoice[stage.id] = k;
+    renderImagePicker(stage);
+    renderStageImage(stage);
+    redrawAll();
   }
 
   function renderStageImage(stage) {
@@ -766,6 +768,7 @@
       ArrowLeft: () => selectStage(state.stagePos - 1), k: () => selectStage(state.stagePos - 1),
       ArrowDown: () => stepProbe(+1), n: () => stepProbe(+1),
       ArrowUp: () => stepProbe(-1), p: () => stepProbe(-1),
+      i: nextImage,
       '+': () => setZoom(state.zoom + 1), '=': () => setZoom(state.zoom + 1),
       '-': () => setZoom(state.zoom - 1), '0': fitZoom,
     };
@@ -773,6 +776,13 @@
     if (!action) return;
     ev.preventDefault(); // arrows would scroll the page
     guard(`key ${ev.key}`, action);
+  }
+
+  // Cycles through the current stage's images (layers, levels), as the picker's buttons do.
+  function nextImage() {
+    const stage = state.stages[state.stagePos];
+    if (!stage || stage.images.length < 2) return;
+    showImage(stage, ((state.imageChoice[stage.id] || 0) + 1) % stage.images.length);
   }
 
   function stepProbe(delta) {

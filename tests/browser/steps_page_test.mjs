@@ -106,6 +106,10 @@ async function checkEveryStageByClick(page, data) {
       if (images.length > 1) await page.locator(`#image-picker button[data-image-index="${k}"]`).click();
       await checkStageImage(page, stage.id, images[k]);
     }
+    if (images.length > 1) {
+      await page.keyboard.press('i'); // wraps from the last image to the first
+      check(await attr(page, '#stage-image', 'data-file') === images[0].file, `${stage.id}: i cycles to the first image`);
+    }
     if (images.length === 0) check(await page.locator('#stage-image').count() === 0, `${stage.id}: no image shown`);
   }
   for (const key of ['result', 'reference', 'difference']) {
