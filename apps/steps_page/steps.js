@@ -67,6 +67,7 @@
   // attributes keep the exact values.
   function fmt(v) {
     if (v === null || v === undefined) return '—';
+    if (typeof v === 'object') return JSON.stringify(v);
     if (typeof v !== 'number') return String(v);
     if (Number.isInteger(v)) return String(v);
     return String(Number(v.toPrecision(6)));
