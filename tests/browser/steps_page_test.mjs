@@ -270,6 +270,35 @@ async function testFolder(browser, args, method, dir) {
   await page.close();
 }
 
+// A damaged folder (fixture mode): a missing image, malformed stages and probes, and no
+// steps_data.js at all must each give a visible message and no page error. (Chromium itself logs
+// the failed file:// load of a missing file as a console error; the page cannot prevent that.)
+async function checkDamagedFolders(browser, dir) {
+  const data = JSON.parse(fs.readFileSync(path.join(dir, 'steps.json'), 'utf8'));
+  const first = data.stages[0].images[0].file;
+  fs.rmSync(path.join(dir, first));
+  data.stages.splice(1, 0, 42);                     // not an object
+  data.stages[2].images = 'not a list';
+  data.probes.push({ x: 'a' });                     // no integer x, y
+  fs.writeFileSync(path.join(dir, 'steps_data.js'), `window.FOCAL_STEPS = ${JSON.stringify(data)};\n`);
+  const expect = [`Could not load ${first}`, 'stages[1] is not an object', '"images" is not a list',
+                  'has no integer x, y'];
+  const page = await browser.newPage();
+  const pageErrors = [];
+  page.on('pageerror', (e) => pageErrors.push(e.message));
+  await page.goto('file://' + path.join(dir, 'index.html'));
+  await page.waitForSelector('#stage-image[data-loaded]', { state: 'attached' });
+  const shown = (await page.locator('#messages').innerText());
+  for (const text of expect) check(shown.includes(text), `damaged folder: the page says "${text}"`);
+  check(await page.locator('#stage-viewport .image-error').count() === 1, 'damaged folder: the missing image is replaced by a message');
+  fs.rmSync(path.join(dir, 'steps_data.js'));
+  await page.reload();
+  check((await page.locator('#messages').innerText()).includes('steps_data.js is missing'),
+        'no steps_data.js: the page says so');
+  check(pageErrors.length === 0, `damaged folders: no page errors (${pageErrors.join(' | ')})`);
+  await page.close();
+}
+
 // The docs' picture: the stage a probe draws most on, with that probe selected.
 async function screenshot(page, data, method) {
   const probe = data.probes[Math.floor(data.probes.length / 2)];
@@ -309,6 +338,7 @@ async function main() {
       console.log(`${method}: ${args.fixture ? 'make_fixture.py' : 'focal steps'} -> ${path.join(args.work, method)}`);
       const dir = makeFolder(args, method);
       await testFolder(browser, args, method, dir);
+      if (args.fixture) await checkDamagedFolders(browser, dir);
     }
   } finally {
     await browser.close();
