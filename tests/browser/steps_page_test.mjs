@@ -138,7 +138,7 @@ async function checkKeyboardStepping(page) {
 function frameStage(data, probe) {
   const framed = data.stages.filter((s) => (s.images || []).length > 0 &&
     (s.images[0].scale || 1) === 1 && s.images[0].width === data.width);
-  const drawn = framed.find((s) => (probe.draw || []).some((d) => d.stages.includes(s.id) && !d.stages.includes('*')));
+  const drawn = framed.find((s) => (probe.draw || []).some((d) => (d.stages || []).includes(s.id) && !(d.stages || []).includes('*')));
   return drawn || framed[0];
 }
 
@@ -181,7 +181,7 @@ async function checkProbes(page, args, data) {
         `reference_rgba ${JSON.stringify(shown.reference)} = focal probe's ${JSON.stringify(expected.reference_rgba)}`);
   check(sameNumbers(probe.rgba, expected.rgba), 'steps.json and focal probe agree on rgba');
   // Its shapes for this stage, and the crosshair, are drawn over the image.
-  const wanted = (probe.draw || []).filter((d) => d.stages.includes('*') || d.stages.includes(stage.id)).length;
+  const wanted = (probe.draw || []).filter((d) => (d.stages || []).includes('*') || (d.stages || []).includes(stage.id)).length;
   const drawn = await page.locator('#stage-overlay .shape, #stage-overlay .point').count();
   check(drawn === wanted, `${wanted} shapes of the probe drawn on ${stage.id} (got ${drawn})`);
   check(await page.locator('#stage-overlay .crosshair').count() > 0, 'a crosshair on the probed pixel');
