@@ -732,6 +732,9 @@
     if (Array.isArray(value) && value.length <= 16 && value.every((v) => v === null || typeof v !== 'object')) {
       return el('div', { class: 'leaf' }, [label, `: [${value.map(fmt).join(', ')}]`]);
     }
+    if (Object.keys(value).length === 0) {
+      return el('div', { class: 'leaf' }, [label, Array.isArray(value) ? ': [] (empty)' : ': {} (empty)']);
+    }
     const details = el('details', depth < 2 ? { open: '' } : {});
     const size = Array.isArray(value) ? `[${value.length}]` : `{${Object.keys(value).length}}`;
     details.append(el('summary', {}, [label, ` ${size}`]));

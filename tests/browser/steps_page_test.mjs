@@ -31,7 +31,8 @@ function parseArgs(argv) {
     else throw new Error(`unknown argument ${argv[i]} (usage: --focal PATH | --fixture, [--work DIR])`);
   }
   if (!args.fixture && !args.focal) throw new Error('give --focal PATH (or FOCAL_BINARY) or --fixture');
-  args.work = args.work || fs.mkdtempSync(path.join(os.tmpdir(), 'focal-steps-page-'));
+  args.work = path.resolve(args.work || fs.mkdtempSync(path.join(os.tmpdir(), 'focal-steps-page-')));
+  fs.mkdirSync(args.work, { recursive: true });
   return args;
 }
 
@@ -57,8 +58,9 @@ function makeFolder(args, method) {
   if (args.fixture) {
     execFileSync('python3', [path.join(here, 'make_fixture.py'), dir, path.join(root, 'apps', 'steps_page')]);
   } else {
-    execFileSync(args.focal, ['steps', 'builtin:demo', '--method', method, ...kSize, ...kStepsOnly, '-o', dir],
-                 { stdio: ['ignore', 'ignore', 'inherit'] });
+    // Run in the work folder with a relative -o, so the page's command line reads "-o METHOD".
+    execFileSync(path.resolve(args.focal), ['steps', 'builtin:demo', '--method', method, ...kSize, ...kStepsOnly,
+                 '-o', method], { cwd: args.work, stdio: ['ignore', 'ignore', 'inherit'] });
   }
   // focal writes the page from its embedded copy (apps/steps_page.h).
   for (const name of ['index.html', 'steps.css', 'steps.js']) {
@@ -147,7 +149,7 @@ function frameStage(data, probe) {
   const framed = data.stages.filter((s) => (s.images || []).length > 0 &&
     (s.images[0].scale || 1) === 1 && s.images[0].width === data.width);
   const drawn = framed.find((s) => (probe.draw || []).some((d) => (d.stages || []).includes(s.id) && !(d.stages || []).includes('*')));
-  return drawn || framed[0];
+  return drawn || framed.find((s) => s.group === data.method) || framed[0];
 }
 
 async function clickFramePixel(page, x, y) {
@@ -309,7 +311,8 @@ async function checkDamagedFolders(browser, dir) {
   await page.close();
 }
 
-// The docs' picture: the stage a probe draws most on, with that probe selected.
+// The docs' picture: the stage the middle probe draws on (else the method's first stage in frame
+// pixels), with that probe selected.
 async function screenshot(page, data, method) {
   const probe = data.probes[Math.floor(data.probes.length / 2)];
   const stage = frameStage(data, probe);
