@@ -4,7 +4,10 @@
 // folder format they read is docs/steps-format.md.
 #pragma once
 
+#include <raster/status.h>
+
 #include <span>
+#include <string>
 #include <string_view>
 
 namespace focal {
@@ -16,5 +19,9 @@ struct StepsPageFile {
 
 // The page's files, in the order index.html, steps.css, steps.js. Valid for the program's lifetime.
 std::span<const StepsPageFile> stepsPageFiles();
+
+// Writes every file of stepsPageFiles() into the existing folder `dir` (each atomically, like
+// writeTextFile), so the folder opens in a browser once steps_data.js and images/ are there.
+raster::Status writeStepsPage(const std::string& dir);
 
 } // namespace focal
