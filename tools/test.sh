@@ -3,9 +3,9 @@
 # the Release build (every test: quick, full, golden and stress tiers; warnings as errors), the
 # installed package in projects outside the tree (tools/package-check.sh), the ASan+UBSan build
 # (quick tier, with the allocation and fault-injection tests), a clang++ Release build of focal and the golden tests (which must match the same
-# goldens as g++), ThreadSanitizer on the pinhole determinism sweeps, and each libFuzzer target
-# for 60 s (docs/testing.md, "What runs where"). Each step prints its wall time, so a slow CI run
-# shows where the time went.
+# goldens as g++), ThreadSanitizer on the pinhole determinism sweeps, each libFuzzer target
+# for 60 s, and the stage-stepper page in Debian's Chromium (label browser; docs/testing.md,
+# "What runs where"). Each step prints its wall time, so a slow CI run shows where the time went.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$SECONDS
@@ -19,7 +19,11 @@ jobs=$(nproc)
 step "install" tools/install-deps.sh
 cmake --preset release >/dev/null
 step "release build" cmake --build --preset release -- -j"$jobs"
-step "release tests" ctest --preset release -j"$jobs"
+# Every tier but browser, which has its own step below (so its time shows on its own line).
+step "release tests" ctest --preset release -j"$jobs" -LE browser
+# The steps page (tests/browser) with the release build's focal, in /usr/bin/chromium driven by
+# playwright-core; one test at a time (each starts its own browser).
+step "browser tests" ctest --preset release --no-tests=error -L browser
 # The installed package in projects outside the tree: a library-only build (no OpenImageIO)
 # with examples/embed, and the release build's install with examples/golden-installed.
 step "package" tools/package-check.sh
