@@ -21,20 +21,6 @@ struct MultilayerArgs {
     std::string levels_out;           // prefix of the per-level contribution images (Fig. 7)
 };
 
-const char* kindName(dof::LevelKind k) {
-    switch (k) {
-    case dof::LevelKind::Base:
-        return "base";
-    case dof::LevelKind::Mip:
-        return "mip";
-    case dof::LevelKind::Stack:
-        return "stack";
-    case dof::LevelKind::Aperture:
-        return "aperture";
-    }
-    return "?";
-}
-
 raster::Result<dof::MethodSettings> multilayerSettings(const MultilayerArgs& args,
                                                        const MethodContext& in) {
     dof::MultilayerSettings settings = args.settings;
@@ -77,7 +63,7 @@ raster::Status finishMultilayer(const MultilayerArgs& args, const dof::MethodSet
         settings.depth_format == raster::DepthFormat::Unorm16 ? "unorm16" : "float32";
     auto levelJson = [](const dof::MultilayerLevelStats& l) {
         nlohmann::json j = {{"level", l.index},
-                            {"kind", kindName(l.kind)},
+                            {"kind", dof::levelKindName(l.kind)},
                             {"width", l.width},
                             {"height", l.height},
                             {"dilation", l.dilation},
@@ -104,7 +90,7 @@ raster::Status finishMultilayer(const MultilayerArgs& args, const dof::MethodSet
             return std::isfinite(z) ? nlohmann::json(z) : nlohmann::json(nullptr);
         };
         traversal.push_back({{"level", t.index},
-                             {"kind", kindName(t.kind)},
+                             {"kind", dof::levelKindName(t.kind)},
                              {"reads", t.level},
                              {"radius_px", t.radius_px},
                              {"z_near", finite(t.z_near)},

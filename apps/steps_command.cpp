@@ -3,6 +3,7 @@
 #include "apps/image_io.h"
 #include "apps/render_request.h"
 #include "apps/settings_options.h"
+#include "apps/steps_page.h"
 #include "apps/steps_recorder.h"
 #include "apps/text_file.h"
 
@@ -250,6 +251,8 @@ int runSteps(StepsArgs& args) {
     if (Status s =
             writeTextFile(*folder + "/steps_data.js", "window.FOCAL_STEPS = " + json + ";\n");
         !s.ok())
+        return failed(s.message());
+    if (Status s = writeStepsPage(*folder); !s.ok())
         return failed(s.message());
     if (Status s = replaceFolder(*folder, args.out_dir); !s.ok())
         return failed(s.message());

@@ -315,8 +315,13 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
             }
             return renderPinhole(call.scene, v, call.options, f, call.report);
         };
+        AccumSettings settings = m->settings;
+        if (observer) { // each view's sample at the observer's pixels
+            settings.probe_pixels = observer->probePixels();
+            settings.probes = &observedAccumProbes();
+        }
         raster::Result<AccumStats> r =
-            renderAccum(view, lens, *m->samples, m->settings, render_view, accum_, &pool_,
+            renderAccum(view, lens, *m->samples, settings, render_view, accum_, &pool_,
                         observer ? observeAccum(view, lens, *m) : m->progress, &accum_scratch_);
         if (!r.ok())
             return r.status();
@@ -366,7 +371,9 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         if (!m->samples)
             return Status::error("multiview: needs lens samples (MultiviewMethod::samples is "
                                  "null)");
-        MultiviewSettings settings = m->settings;
+        // Kept: a probe of the frame re-traces with the same settings (frame_stages.cpp).
+        MultiviewSettings& settings = multiview_settings_;
+        settings = m->settings;
         settings.seed = m->samples->seed();
         settings.sequence_2n = nullptr;
         if (settings.jitter == JitterMode::Halton) {

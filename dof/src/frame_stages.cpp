@@ -26,6 +26,7 @@ struct detail::FrameObservation {
     std::vector<uint32_t> tile_triangles;
     uint32_t tiles_x = 0, tiles_y = 0;
     std::vector<float> coc; // gather's signed CoC map when the caller asked for none
+    std::vector<AccumPixelProbe> accum_probes;
     // accum: a few single views and the running average after 1, 2, 4, ... views.
     std::vector<std::pair<uint32_t, std::vector<float>>> views, averages;
     double weight_sum = 0.0;
@@ -259,6 +260,43 @@ std::vector<float>& FrameRenderer::observedCoc() {
     return observation().coc;
 }
 
+std::vector<AccumPixelProbe>& FrameRenderer::observedAccumProbes() {
+    return observation().accum_probes;
+}
+
+Status FrameRenderer::probeMethod(const raster::Scene& scene, const raster::View& view,
+                                  const ThinLens& lens, const raster::RenderOptions& options,
+                                  const MethodSettings& method, size_t index, PixelProbe& probe) {
+    const uint32_t x = probe.x, y = probe.y;
+    if (std::holds_alternative<AccumMethod>(method)) {
+        probe.method = observation().accum_probes.at(index);
+        return {};
+    }
+    if (const GatherMethod* m = std::get_if<GatherMethod>(&method)) {
+        GatherSettings settings = m->settings; // as renderFrame derived them
+        settings.tile_size = options.tile_size;
+        settings.simd = options.simd;
+        GatherImage in;
+        in.rgba = pinhole_.color.data();
+        in.depth = depthRefOf(pinhole_.depth);
+        in.width = pinhole_.width;
+        in.height = pinhole_.height;
+        return probeGather(in, lens, pinholeView(view), settings, gather_scratch_, x, y,
+                           probe.method.emplace<GatherPixelProbe>());
+    }
+    if (const MultiviewMethod* m = std::get_if<MultiviewMethod>(&method)) {
+        ShadingInputs shading;
+        shading.scene = &scene;
+        shading.simd = options.simd;
+        return probeMultiview(view, lens, *m->samples, pinhole_, layers_, multiview_settings_,
+                              shading, multiview_scratch_, x, y,
+                              probe.method.emplace<MultiviewPixelProbe>());
+    }
+    if (std::holds_alternative<MultilayerMethod>(method))
+        return multilayer_.probe(x, y, probe.method.emplace<MultilayerPixelProbe>());
+    return {};
+}
+
 ProgressFn FrameRenderer::observeAccum(const raster::View& view, const ThinLens& lens,
                                        const AccumMethod& m) {
     detail::FrameObservation& o = observation();
@@ -422,10 +460,13 @@ Status FrameRenderer::observeFrame(const raster::Scene& scene, const raster::Vie
     }
     resultStage(methodName(method), image, w, h, observer);
 
-    for (const glm::uvec2& p : probes) {
+    for (size_t n = 0; n < probes.size(); ++n) {
+        const glm::uvec2 p = probes[n];
         PixelProbe probe;
         probe.x = p.x;
         probe.y = p.y;
+        if (Status s = probeMethod(scene, view, lens, options, method, n, probe); !s.ok())
+            return s;
         const float* px = image.rgba + size_t(p.y) * image.stride + size_t(p.x) * 4;
         std::copy(px, px + 4, probe.rgba);
         const size_t i = size_t(p.y) * w + p.x;

@@ -7,6 +7,20 @@
 #include <limits>
 
 namespace dof {
+
+const char* levelKindName(LevelKind kind) {
+    switch (kind) {
+    case LevelKind::Base:
+        return "base";
+    case LevelKind::Mip:
+        return "mip";
+    case LevelKind::Stack:
+        return "stack";
+    case LevelKind::Aperture:
+        return "aperture";
+    }
+    return "?";
+}
 namespace {
 
 // Mean over the pixel centres of one period of the variance a bilinear lookup adds per axis:

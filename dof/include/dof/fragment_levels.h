@@ -52,6 +52,9 @@ enum class LevelKind : uint8_t {
               // (dof/aperture_grid.h): a disc (or polygon, or image) of diameter G·2^source
 };
 
+// The kind's name in --stats and probes: "base", "mip", "stack", "aperture".
+const char* levelKindName(LevelKind kind);
+
 // One level of the hierarchy: width x height cells, each a depth-sorted fragment list. Cells are
 // stored row by row (each row a consecutive array, the row's lists compacted with a prefix sum),
 // so one task can build one row without knowing the other rows' sizes.

@@ -11,6 +11,11 @@
 // changes the frame's bytes; a frame rendered without an observer does none of it.
 #pragma once
 
+#include <dof/accum.h>
+#include <dof/gather.h>
+#include <dof/multilayer.h>
+#include <dof/multiview.h>
+
 #include <glm/vec2.hpp>
 
 #include <cstddef>
@@ -86,6 +91,13 @@ struct PixelProbe {
     uint32_t x = 0, y = 0;
     float rgba[4] = {}; // the frame's result at the pixel (the bytes written to the image)
     std::vector<ProbeFragment> fragments;
+    // The method's own record, made by the method's code on this frame's data: accum's views
+    // (accum.h), gather's taps (probeGather), multiview's lens rays (probeMultiview),
+    // multilayer's reads and slices (Multilayer::probe); nothing for pinhole. Its rgba equals
+    // `rgba` bit for bit.
+    std::variant<std::monostate, AccumPixelProbe, GatherPixelProbe, MultiviewPixelProbe,
+                 MultilayerPixelProbe>
+        method;
 };
 
 class FrameObserver {

@@ -195,6 +195,12 @@ private:
     // and running averages, and the stages and probes after the frame.
     detail::FrameObservation& observation();
     std::vector<float>& observedCoc(); // gather's signed CoC map, for its stage
+    // accum's probes of the observer's pixels, filled by renderAccum
+    std::vector<AccumPixelProbe>& observedAccumProbes();
+    // The method's record of pixel (x, y) of the frame just rendered (PixelProbe::method).
+    raster::Status probeMethod(const raster::Scene& scene, const raster::View& view,
+                               const ThinLens& lens, const raster::RenderOptions& options,
+                               const MethodSettings& method, size_t index, PixelProbe& probe);
     ProgressFn observeAccum(const raster::View& view, const ThinLens& lens, const AccumMethod& m);
     raster::Status observeFrame(const raster::Scene& scene, const raster::View& view,
                                 const ThinLens& lens, const raster::RenderOptions& options,
@@ -224,6 +230,7 @@ private:
     std::optional<LensSampleSet> sequence_2n_; // multiview's §4.5 Halton set
     Multilayer multilayer_;
     MultilayerImage multilayer_image_;
+    MultiviewSettings multiview_settings_;   // the frame's, with seed and sequence_2n (probes)
     MultilayerSettings multilayer_settings_; // the frame's, with what the frame renderer fills in
     FrameReport report_;                     // the report of a render() call given none
     std::unique_ptr<detail::FrameObservation, detail::FrameObservationDeleter> observation_;

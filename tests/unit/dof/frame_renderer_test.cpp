@@ -12,6 +12,8 @@
 #include <map>
 #include <span>
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 namespace focal::test {
@@ -434,6 +436,18 @@ TEST(FrameRenderer, AnObserverSeesEveryStageInOrderAndChangesNoByte) {
                     std::memcmp(p.rgba, &want[(size_t(p.y) * view.width + p.x) * 4], sizeof p.rgba),
                     0)
                     << name << " " << p.x << "," << p.y;
+            // The method's own record (its probe function on the frame's kept data) agrees.
+            for (const dof::PixelProbe& p : rec.probes) {
+                EXPECT_EQ(p.method.index() == 0, name == "pinhole") << name;
+                std::visit(
+                    [&](const auto& m) {
+                        if constexpr (!std::is_same_v<std::decay_t<decltype(m)>, std::monostate>) {
+                            EXPECT_EQ(std::memcmp(m.rgba, p.rgba, sizeof p.rgba), 0)
+                                << name << " " << p.x << "," << p.y;
+                        }
+                    },
+                    p.method);
+            }
             // The result stage shows the result.
             const dof::StageImage& result = rec.find("result.image").images.at(0);
             EXPECT_EQ(std::memcmp(result.pixels, want.data(), want.size() * sizeof(float)), 0)
