@@ -24,9 +24,9 @@ std::string imageFile(const std::string& stage_id, size_t index) {
     return "images/" + name + suffix;
 }
 
-std::string number(double v) {
+std::string number(float v) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", v);
+    std::snprintf(buf, sizeof buf, "%.4g", double(v));
     return buf;
 }
 
@@ -113,6 +113,10 @@ nlohmann::json rgbaJson(const float* v) {
 
 nlohmann::json finiteOrNull(double v) {
     return std::isfinite(v) ? nlohmann::json(v) : nullptr;
+}
+
+nlohmann::json finiteOrNull(float v) {
+    return finiteOrNull(double(v));
 }
 
 StepsRecorder::StepsRecorder(std::string folder, std::vector<glm::uvec2> probes)

@@ -42,5 +42,6 @@ private:
 
 // A JSON number for a float that may be infinite or NaN (JSON has neither): null then.
 nlohmann::json finiteOrNull(double v);
+nlohmann::json finiteOrNull(float v);
 
 } // namespace focal

@@ -65,7 +65,7 @@ inline Moments momentsOf(const raster::Frame& f, glm::dvec2 centre, float thresh
     double r2 = 0.0;
     for (uint32_t y = 0; y < f.height; ++y)
         for (uint32_t x = 0; x < f.width; ++x) {
-            const double v = f.color[(size_t(y) * f.width + x) * 4];
+            const double v = double(f.color[(size_t(y) * f.width + x) * 4]);
             if (v <= double(threshold))
                 continue;
             const glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);

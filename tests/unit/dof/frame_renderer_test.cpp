@@ -437,13 +437,14 @@ TEST(FrameRenderer, AnObserverSeesEveryStageInOrderAndChangesNoByte) {
                     0)
                     << name << " " << p.x << "," << p.y;
             // The method's own record (its probe function on the frame's kept data) agrees.
+            const std::string& method_name = name; // a lambda cannot capture a binding (C++17)
             for (const dof::PixelProbe& p : rec.probes) {
                 EXPECT_EQ(p.method.index() == 0, name == "pinhole") << name;
                 std::visit(
                     [&](const auto& m) {
                         if constexpr (!std::is_same_v<std::decay_t<decltype(m)>, std::monostate>) {
                             EXPECT_EQ(std::memcmp(m.rgba, p.rgba, sizeof p.rgba), 0)
-                                << name << " " << p.x << "," << p.y;
+                                << method_name << " " << p.x << "," << p.y;
                         }
                     },
                     p.method);
