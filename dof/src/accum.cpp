@@ -60,6 +60,8 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
         return s;
     if (samples.size() == 0)
         return Status::error("accum: the lens sample set is empty");
+    if (kept)
+        kept->last_view = nullptr; // no view added yet in this frame
     std::vector<AccumPixelProbe>* probes = settings.probes;
     if (probes) {
         probes->assign(settings.probe_pixels.size(), AccumPixelProbe{});
@@ -114,7 +116,8 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
     buffers.sums.assign(floats, 0.0);
     double* acc = buffers.sums.data();
     raster::Frame& scratch = buffers.view;
-    double weight_sum = 0.0;
+    double& weight_sum = buffers.weight_sum;
+    weight_sum = 0.0;
     const uint32_t n = samples.size();
     for (uint32_t i = 0; i < n; ++i) {
         const LensSample& ls = samples.sample(i);
@@ -155,6 +158,7 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
             for (uint32_t row = 0; row < height; ++row)
                 addRow(row, 0);
         weight_sum += w;
+        buffers.last_view = src;
         stats.ms_accumulate += msSince(t0);
         ++stats.views;
         if (progress)

@@ -322,7 +322,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         }
         raster::Result<AccumStats> r =
             renderAccum(view, lens, *m->samples, settings, render_view, accum_, &pool_,
-                        observer ? observeAccum(view, lens, *m) : m->progress, &accum_scratch_);
+                        observer ? observeAccum(*m) : m->progress, &accum_scratch_);
         if (!r.ok())
             return r.status();
         copyRows(accum_.color.data(), view.width, view.height, image);

@@ -29,7 +29,6 @@ struct detail::FrameObservation {
     std::vector<AccumPixelProbe> accum_probes;
     // accum: a few single views and the running average after 1, 2, 4, ... views.
     std::vector<std::pair<uint32_t, std::vector<float>>> views, averages;
-    double weight_sum = 0.0;
 };
 
 namespace {
@@ -106,6 +105,11 @@ void distanceImage(StageBuilder& b, std::string name, std::string caption, const
     float* dst = b.image(std::move(name), std::move(caption), StageImageKind::Distance, w, h, 1);
     for (size_t i = 0; i < size_t(w) * h; ++i)
         dst[i] = distanceOf(view, depth.load(first + i));
+}
+
+// Colour times alpha, and alpha: how a target's RGBA is shown over black.
+void storePremultiplied(glm::vec4 v, float* dst) {
+    dst[0] = v.r * v.a, dst[1] = v.g * v.a, dst[2] = v.b * v.a, dst[3] = v.a;
 }
 
 std::string layerName(uint32_t l) {
@@ -206,9 +210,7 @@ void rasterStages(const raster::View& pin, const raster::RenderOptions& options,
                                StageImageKind::Color, w, h, 4);
             for (size_t i = 0; i < size_t(w) * h; ++i)
                 if (lists.count(i) > k) {
-                    const glm::vec4 v = lists.color.load(lists.offsets[i] + k);
-                    c[4 * i] = v.r * v.a, c[4 * i + 1] = v.g * v.a, c[4 * i + 2] = v.b * v.a;
-                    c[4 * i + 3] = v.a;
+                    storePremultiplied(lists.color.load(lists.offsets[i] + k), c + 4 * i);
                 }
         }
         for (uint32_t k = 0; k < kListEntriesShown; ++k) {
@@ -297,34 +299,24 @@ Status FrameRenderer::probeMethod(const raster::Scene& scene, const raster::View
     return {};
 }
 
-ProgressFn FrameRenderer::observeAccum(const raster::View& view, const ThinLens& lens,
-                                       const AccumMethod& m) {
+ProgressFn FrameRenderer::observeAccum(const AccumMethod& m) {
     detail::FrameObservation& o = observation();
     o.views.clear();
     o.averages.clear();
-    o.weight_sum = 0.0;
-    return [this, &o, &m, view, lens](uint32_t done, uint32_t total) {
+    return [this, &o, &m](uint32_t done, uint32_t total) {
         if (m.progress)
             m.progress(done, total);
-        if (accum_scratch_.sums.empty() || done == 0 || done > m.samples->size())
+        const AccumScratch& a = accum_scratch_;
+        if (!a.last_view || done == 0)
             return; // skipped: the pinhole is the result, no view was added
-        const uint32_t i = done - 1;
-        const LensSample& s = m.samples->sample(i);
-        o.weight_sum += double(s.weight);
-        // The view just added: the scratch frame, or the pinhole when accum used it (the lens
-        // centre without a sub-pixel shift, as renderAccum decides).
-        const glm::vec2 shift = m.settings.pixel_jitter ? pixelJitter(i) : glm::vec2(0.0f);
-        const bool rendered =
-            lensView(view, lens, s.position, shift).lens_offset != glm::vec2(0.0f) ||
-            shift != glm::vec2(0.0f);
-        if (i < kAccumViewsShown)
-            o.views.emplace_back(i, rendered ? accum_scratch_.view.color : accum_.color);
+        if (done - 1 < kAccumViewsShown)
+            o.views.emplace_back(done - 1, a.last_view->color);
         if ((done & (done - 1)) == 0 || done == total) {
             // sums / weights so far, as renderAccum normalises the final one.
-            const double inv = 1.0 / o.weight_sum;
-            std::vector<float> avg(accum_scratch_.sums.size());
+            const double inv = 1.0 / a.weight_sum;
+            std::vector<float> avg(a.sums.size());
             for (size_t k = 0; k < avg.size(); ++k)
-                avg[k] = float(accum_scratch_.sums[k] * inv);
+                avg[k] = float(a.sums[k] * inv);
             o.averages.emplace_back(done, std::move(avg));
         }
     };
@@ -527,11 +519,8 @@ void FrameRenderer::multiviewStages(const raster::View& view, const ThinLens& le
         for (uint32_t l = 0; l < t.layer_count; ++l) {
             float* c = b.image(layerName(l) + " colour", "colour times coverage",
                                StageImageKind::Color, w, h, 4);
-            for (size_t i = 0; i < n; ++i) {
-                const glm::vec4 v = t.color.load(size_t(l) * n + i);
-                c[4 * i] = v.r * v.a, c[4 * i + 1] = v.g * v.a, c[4 * i + 2] = v.b * v.a;
-                c[4 * i + 3] = v.a;
-            }
+            for (size_t i = 0; i < n; ++i)
+                storePremultiplied(t.color.load(size_t(l) * n + i), c + 4 * i);
         }
         for (uint32_t l = 0; l < t.layer_count; ++l)
             distanceImage(b, layerName(l) + " depth", "distance of the layer's surface", pin,

@@ -84,6 +84,11 @@ struct AccumStats {
 struct AccumScratch {
     std::vector<double> sums; // RGBA per pixel
     raster::Frame view;
+    // After each view is added (when progress is called): the frame it was read from (`view`,
+    // or the output frame holding the pinhole when the view is the lens centre without shift)
+    // and the sum of the weights added so far; sums / weight_sum is the running average.
+    const raster::Frame* last_view = nullptr;
+    double weight_sum = 0.0;
 };
 
 // The sheared view for lens sample `sample` (lens units) and sub-pixel shift `pixel_shift`.

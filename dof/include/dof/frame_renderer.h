@@ -201,7 +201,7 @@ private:
     raster::Status probeMethod(const raster::Scene& scene, const raster::View& view,
                                const ThinLens& lens, const raster::RenderOptions& options,
                                const MethodSettings& method, size_t index, PixelProbe& probe);
-    ProgressFn observeAccum(const raster::View& view, const ThinLens& lens, const AccumMethod& m);
+    ProgressFn observeAccum(const AccumMethod& m);
     raster::Status observeFrame(const raster::Scene& scene, const raster::View& view,
                                 const ThinLens& lens, const raster::RenderOptions& options,
                                 const MethodSettings& method, const FrameReport& report,

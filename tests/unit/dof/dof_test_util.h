@@ -6,6 +6,7 @@
 #include <dof/accum.h>
 #include <dof/lens.h>
 #include <dof/lens_samples.h>
+#include <dof/multiview.h>
 #include <raster/check.h>
 #include <raster/renderer.h>
 #include <raster/task_pool.h>
@@ -16,6 +17,23 @@
 #include <cmath>
 
 namespace focal::test {
+
+// Multiview's render callbacks through a real renderer; the renderer, scene and options must
+// outlive them.
+inline dof::PinholeFn pinholeFnOf(raster::Renderer& renderer, const raster::Scene& scene,
+                                  const raster::RenderOptions& options) {
+    return [&renderer, &scene, &options](const raster::View& v, raster::Frame& f) {
+        return renderer.render(scene, v, options, f);
+    };
+}
+
+inline dof::LayersFn layersFnOf(raster::Renderer& renderer, const raster::Scene& scene,
+                                const raster::RenderOptions& options) {
+    return [&renderer, &scene, &options](const raster::View& v, const raster::LayeredTargetDesc& d,
+                                         raster::LayeredTarget& t) {
+        return renderer.renderLayers(scene, v, options, d, t);
+    };
+}
 
 inline raster::Frame renderAccum(const raster::Scene& scene, const raster::View& view,
                                  const dof::ThinLens& lens, const dof::LensSampleSet& samples,

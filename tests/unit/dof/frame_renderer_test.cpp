@@ -127,13 +127,8 @@ std::vector<float> direct(const std::string& name, const raster::View& view,
         FOCAL_CHECK(seq.ok());
         if (s.jitter == dof::JitterMode::Halton)
             s.sequence_2n = &*seq;
-        const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& out) {
-            return renderer.render(scene, v, options, out);
-        };
-        const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                      raster::LayeredTarget& t) {
-            return renderer.renderLayers(scene, v, options, d, t);
-        };
+        const dof::PinholeFn pin = pinholeFnOf(renderer, scene, options);
+        const dof::LayersFn lay = layersFnOf(renderer, scene, options);
         dof::ShadingInputs shading;
         shading.scene = &scene;
         shading.simd = options.simd;

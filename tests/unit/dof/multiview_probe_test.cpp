@@ -43,13 +43,8 @@ struct KeptFrame {
     // Renders the loaded scene again into the kept buffers (with `lens` as it is now).
     bool renderAgain(const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings) {
         raster::RenderOptions options;
-        const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
-            return renderer.render(scene, v, options, f);
-        };
-        const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                      raster::LayeredTarget& t) {
-            return renderer.renderLayers(scene, v, options, d, t);
-        };
+        const dof::PinholeFn pin = pinholeFnOf(renderer, scene, options);
+        const dof::LayersFn lay = layersFnOf(renderer, scene, options);
         raster::Result<dof::MultiviewStats> r =
             dof::renderMultiview(view, lens, samples, settings, shading, scene.background, pin, lay,
                                  pool, rgba, &pinhole, &layers, &scratch);

@@ -27,13 +27,8 @@ tryMultiview(const raster::Scene& scene, const raster::View& view, const dof::Th
     raster::TaskPool pool(threads);
     raster::Renderer renderer(pool);
     raster::RenderOptions options;
-    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
-        return renderer.render(scene, v, options, f);
-    };
-    const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                  raster::LayeredTarget& t) {
-        return renderer.renderLayers(scene, v, options, d, t);
-    };
+    const dof::PinholeFn pin = pinholeFnOf(renderer, scene, options);
+    const dof::LayersFn lay = layersFnOf(renderer, scene, options);
     dof::ShadingInputs shading;
     shading.scene = &scene;
     shading.simd = simd;
@@ -737,13 +732,8 @@ TEST(Multiview, BuffersKeptBetweenFramesGiveTheSameBytes) {
     dof::MultiviewScratch scratch;
     auto kept = [&](const raster::Scene& scene, const raster::View& view, const dof::ThinLens& lens,
                     const dof::LensSampleSet& samples, const dof::MultiviewSettings& settings) {
-        const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
-            return renderer.render(scene, v, options, f);
-        };
-        const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
-                                      raster::LayeredTarget& t) {
-            return renderer.renderLayers(scene, v, options, d, t);
-        };
+        const dof::PinholeFn pin = pinholeFnOf(renderer, scene, options);
+        const dof::LayersFn lay = layersFnOf(renderer, scene, options);
         dof::ShadingInputs shading;
         shading.scene = &scene;
         std::vector<float> rgba;
