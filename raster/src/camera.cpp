@@ -3,6 +3,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace raster {
@@ -62,6 +63,34 @@ float distanceFromDepth(const View& view, float stored_depth) {
     const float inv_far = view.zfar > 0.0f ? 1.0f / view.zfar : 0.0f;
     const float inv_d = inv_far - stored_depth * (1.0f / view.znear - inv_far);
     return inv_d > 0.0f ? 1.0f / inv_d : INFINITY;
+}
+
+namespace {
+// Floats (no NaN) as integers in the same order; -0 and +0 share a key.
+int32_t orderedKey(float v) {
+    const int32_t bits = std::bit_cast<int32_t>(v);
+    return bits >= 0 ? bits : -(bits & 0x7fffffff);
+}
+float fromOrderedKey(int32_t key) {
+    return key >= 0 ? std::bit_cast<float>(key)
+                    : std::bit_cast<float>(uint32_t(-key) | 0x80000000u);
+}
+} // namespace
+
+float firstDepthAtDistance(const View& view, float d) {
+    // Bisection over every float from -inf to 1 for the first one that reaches d.
+    int32_t lo = orderedKey(-INFINITY);
+    int32_t hi = orderedKey(1.0f);
+    if (!(distanceFromDepth(view, 1.0f) >= d))
+        return 1.0f;
+    while (lo < hi) { // invariant: the answer's key lies in [lo, hi]
+        const int32_t mid = int32_t(lo + (int64_t(hi) - lo) / 2); // hi - lo can exceed int32
+        if (distanceFromDepth(view, fromOrderedKey(mid)) >= d)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return fromOrderedKey(lo);
 }
 
 View viewFromCamera(const Camera& camera, uint32_t width, uint32_t height) {

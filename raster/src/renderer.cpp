@@ -320,27 +320,39 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     // by one to the layer owning their depth, so the transparent planes need no copy.)
     t0 = std::chrono::steady_clock::now();
     if (desc.routing == LayerRouting::MaxVertexDepth) {
+        // The overlapped intervals as ranges of stored depth [near, far): the same decisions as
+        // testing distanceFromDepth(D) against the intervals, without a division per pixel.
+        float stored_near[kMaxLayers];
+        float stored_far[kMaxLayers];
+        for (uint32_t l = 0; l < layers; ++l) {
+            stored_near[l] = firstDepthAtDistance(view, intervals[l].near_d);
+            stored_far[l] = firstDepthAtDistance(view, intervals[l].far_d);
+        }
         pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
             const TileRect r = tileRect(st.ctx.grid, tile);
             float snapshot[kMaxLayers];
+            uint32_t covered[kMaxLayers];
             for (uint32_t y = r.y0; y < r.y1; ++y)
                 for (uint32_t x = r.x0; x < r.x1; ++x) {
                     const size_t p = size_t(y) * view.width + x;
-                    for (uint32_t l = 0; l < layers; ++l)
+                    uint32_t covered_count = 0;
+                    for (uint32_t l = 0; l < layers; ++l) {
                         snapshot[l] = out.depth.load(out.index(l, p));
-                    for (uint32_t src = 0; src < layers; ++src) {
-                        if (!(snapshot[src] < 1.0f))
-                            continue;
-                        const float d = distanceFromDepth(view, snapshot[src]);
+                        if (snapshot[l] < 1.0f)
+                            covered[covered_count++] = l;
+                    }
+                    for (uint32_t c = 0; c < covered_count; ++c) {
+                        const uint32_t src = covered[c];
+                        const float z = snapshot[src];
                         for (uint32_t dst = 0; dst < layers; ++dst) {
+                            if (dst == src || !(z >= stored_near[dst]) || !(z < stored_far[dst]))
+                                continue;
                             const size_t di = out.index(dst, p);
-                            if (dst == src || !(d >= intervals[dst].near_d) ||
-                                !(d < intervals[dst].far_d) ||
-                                !(snapshot[src] < out.depth.load(di)))
+                            if (!(z < out.depth.load(di)))
                                 continue;
                             const size_t si = out.index(src, p);
                             out.color.store(di, out.color.load(si));
-                            out.depth.store(di, snapshot[src]);
+                            out.depth.store(di, z);
                             if (desc.gbuffer)
                                 out.gbuffer[di] = out.gbuffer[si];
                         }

@@ -51,6 +51,12 @@ glm::mat4 projectionMatrix(const View& view);
 // Stored depth D <-> distance d along the view axis.
 float depthFromDistance(const View& view, float d);
 float distanceFromDepth(const View& view, float stored_depth);
+// The smallest stored depth D with distanceFromDepth(view, D) >= d, or 1 (the cleared value)
+// when no D below 1 reaches d. distanceFromDepth never decreases as D grows (each of its
+// rounded steps is monotone), so for every stored D < 1 the test distanceFromDepth(view, D) >= d
+// has the same outcome as D >= firstDepthAtDistance(view, d): a per-pixel test on distances
+// becomes a compare of stored depths, without the division.
+float firstDepthAtDistance(const View& view, float d);
 
 // The view through scene.cameras[index] for an image of width x height. Non-square glTF
 // aspect ratios keep yfov (vertical fit), as glTF specifies.
