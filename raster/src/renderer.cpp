@@ -338,7 +338,7 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
                     uint32_t covered_count = 0;
                     for (uint32_t l = 0; l < layers; ++l) {
                         snapshot[l] = out.depth.load(out.index(l, p));
-                        if (snapshot[l] < 1.0f)
+                        if (snapshot[l] < kFarDepth) // cleared layers have nothing to copy
                             covered[covered_count++] = l;
                     }
                     for (uint32_t c = 0; c < covered_count; ++c) {
