@@ -207,9 +207,11 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
             stats.scratch_bytes += lv.size() * sizeof(float);
         for (const std::vector<float>& lv : scratch.mips[l])
             stats.scratch_bytes += lv.size() * sizeof(float);
-        if (!scratch.owned_mips.empty())
+        if (!scratch.owned_mips.empty()) {
             for (const std::vector<float>& lv : scratch.owned_mips[l])
                 stats.scratch_bytes += lv.size() * sizeof(float);
+            stats.scratch_bytes += scratch.owned_empty_blocks[l].size();
+        }
         stats.scratch_bytes += scratch.depth[l].size() * sizeof(float);
         if (transparency) {
             for (const std::vector<float>& lv : scratch.transparent_mips[l])

@@ -74,28 +74,26 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
     return out;
 }
 
-// Whether sampleMip on `mip` (Stride channels per texel, a non-negative coverage in channel
-// `channel`) at (px, py) on the levels lv returns exactly 0 in that channel because every
-// texel it reads is empty there: when both levels' taps lie inside their levels, the taps of
-// the finer level l0 lie in the 2x2 blocks the coarser level's four taps average (u0 = 2 u1 +
-// 1/2), so four zero coverages at the last level read decide it. False when unsure.
-template <int Stride>
-bool mipEmptyAt(const MipChain& mip, int channel, float px, float py, MipLevel lv) {
-    const float* taps = nullptr;
-    int64_t row = 0;
+// Whether sampleMip on `mip` (Stride channels per texel, a non-negative coverage in one channel)
+// at (px, py) on the levels lv returns exactly 0 in that channel because every texel it reads is
+// empty there: when both levels' taps lie inside their levels, the taps of the finer level l0
+// lie in the 2x2 blocks the coarser level's four taps average (u0 = 2 u1 + 1/2), so the block
+// of the last level read (lastConeLevel) decides it: `empty_blocks` says which blocks have four
+// zero coverages (MultiviewScratch::owned_empty_blocks). False when unsure.
+inline bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float px, float py,
+                       MipLevel lv) {
+    int64_t block = 0;
     for (const uint32_t level : {lv.l0, lv.l1}) {
         const MipView& m = mip[level];
         const float scale = kMipScale[level];
         const float fu = std::floor(px * scale - 0.5f), fv = std::floor(py * scale - 0.5f);
         if (!(fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v))
             return false;
-        row = m.width * Stride;
-        taps = m.data + (int64_t(fv) * m.width + int64_t(fu)) * Stride + channel;
+        block = int64_t(fv) * m.width + int64_t(fu);
         if (lv.l1 == lv.l0 || lv.f == 0.0f)
             break; // sampleMip reads l0 only
     }
-    return taps[0] == 0.0f && taps[Stride] == 0.0f && taps[row] == 0.0f &&
-           taps[row + Stride] == 0.0f;
+    return empty_blocks[block] != 0;
 }
 
 // The same for a window of `diameter` pixels.
@@ -152,7 +150,7 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
         return std::nullopt;
     const MipChain& owned = tr.owned_mips[l];
     // Most rays pass where the layer owns nothing near them: no coverage, no lookup.
-    if (mipEmptyAt<kOwnedChannels>(owned, 1, px, py, seg.cone_level))
+    if (mipEmptyAt(owned, seg.cone_empty_blocks, px, py, seg.cone_level))
         return std::nullopt;
     const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(owned, px, py, seg.cone_level);
     if (!(d[1] > 0.0f))

@@ -197,6 +197,9 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
     keepLayers(scratch.mips, true);
     keepLayers(scratch.transparent_mips, transparency);
     keepLayers(scratch.owned_mips, settings.cone && settings.cone_misses);
+    scratch.owned_empty_blocks.resize(scratch.owned_mips.size());
+    for (std::vector<uint8_t>& blocks : scratch.owned_empty_blocks)
+        blocks.clear(); // rebuilt below for the layers with missed cones
     scratch.mip_width.clear();
     scratch.mip_height.clear();
     if (settings.cone) {
@@ -214,6 +217,12 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
             scratch.mip_height.push_back(std::max(1u, (scratch.mip_height.back() + 1) / 2));
         }
         stats.mip_levels = levels;
+        for (LayerSeg& seg : tr.segs)
+            if (seg.cone_px > 0.0f) {
+                seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
+                seg.first_cone_px = tr.r_max * std::fabs(tr.cocOf(seg.t_cone)) +
+                                    1.5f * std::ldexp(1.0f, int(seg.cone_level.l1)) + 1.0f;
+            }
         // Level 0 from `level0` (C channels per texel), then 2x2 box reductions.
         auto build = [&]<uint32_t C>(std::vector<std::vector<float>>& mip, auto&& level0) {
             mip.resize(levels);
@@ -265,6 +274,22 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
                     return owned ? std::array<float, kOwnedChannels>{d, 1.0f, c.r, c.g, c.b}
                                  : std::array<float, kOwnedChannels>{};
                 });
+                std::vector<uint8_t>& blocks = scratch.owned_empty_blocks[l];
+                if (tr.segs[l].cone_px > 0.0f) {
+                    // mipEmptyAt's four coverage taps, tested once per block here instead of
+                    // once per missed ray: one byte read, from a map that stays in the cache.
+                    const uint32_t lv = lastConeLevel(tr.segs[l].cone_level);
+                    const size_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
+                    const float* cov = scratch.owned_mips[l][lv].data() + 1;
+                    const size_t row = w * kOwnedChannels;
+                    blocks.assign(w * h, 0);
+                    for (size_t v = 0; v + 1 < h; ++v)
+                        for (size_t u = 0; u + 1 < w; ++u) {
+                            const float* t = cov + (v * w + u) * kOwnedChannels;
+                            blocks[v * w + u] = t[0] == 0.0f && t[kOwnedChannels] == 0.0f &&
+                                                t[row] == 0.0f && t[row + kOwnedChannels] == 0.0f;
+                        }
+                }
             }
             if (transparency) // already premultiplied, alpha = opacity
                 build.template operator()<4>(scratch.transparent_mips[l], [&](size_t i) {
@@ -284,12 +309,9 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
     views(scratch.mips, tr.mips);
     views(scratch.owned_mips, tr.owned_mips);
     views(scratch.transparent_mips, tr.transparent_mips);
-    for (LayerSeg& seg : tr.segs)
-        if (seg.cone_px > 0.0f) {
-            seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
-            seg.first_cone_px = tr.r_max * std::fabs(tr.cocOf(seg.t_cone)) +
-                                1.5f * std::ldexp(1.0f, int(seg.cone_level.l1)) + 1.0f;
-        }
+    for (uint32_t l = 0; l < scratch.owned_empty_blocks.size(); ++l)
+        tr.segs[l].cone_empty_blocks =
+            scratch.owned_empty_blocks[l].empty() ? nullptr : scratch.owned_empty_blocks[l].data();
 }
 
 void buildFirstRays(Tracer& tr) {

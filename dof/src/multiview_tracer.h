@@ -63,6 +63,8 @@ struct LayerSeg {
     float t_cone = 0.0f, cone_px = 0.0f;
     float coc_cone = 0.0f; // C(t_cone): the same for every ray, so computed once
     MipLevel cone_level;   // the levels of that first lookup (its diameter is lambda |C(t_cone)|)
+    // MultiviewScratch::owned_empty_blocks of the layer (null without missed cones)
+    const uint8_t* cone_empty_blocks = nullptr;
     // Every ray's first lookup reads texels within first_cone_px of its pixel's centre: the ray
     // is within r_max |C(t_cone)| of it at t_cone, and a bilinear tap of level L within 1.5 2^L
     // of the ray (+1 for rounding).
@@ -247,6 +249,12 @@ inline MipLevel mipLevelFor(const Tracer& tr, float diameter) {
     const float level = diameter > 1.0f ? std::clamp(std::log2(diameter), 0.0f, float(top)) : 0.0f;
     const uint32_t l0 = uint32_t(level);
     return {l0, std::min(l0 + 1, top), level - float(l0)};
+}
+
+// The level whose taps decide a trilinear lookup on lv is empty (mipEmptyAt): l1 when the
+// lookup blends two levels, else l0.
+inline uint32_t lastConeLevel(MipLevel lv) {
+    return lv.l1 != lv.l0 && lv.f != 0.0f ? lv.l1 : lv.l0;
 }
 
 // The cells a path from offset o0 to o1 can cross lie in the box of its end cells.

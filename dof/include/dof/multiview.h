@@ -287,6 +287,11 @@ struct MultiviewScratch {
     // its depth lies in the layer's own interval, else 0), for the cones of missed rays
     // (MultiviewSettings::cone_misses; empty otherwise)
     std::vector<std::vector<std::vector<float>>> owned_mips;
+    // per layer with missed cones: 1 where the 2x2 block of owned_mips texels from (u, v) has no
+    // coverage, one byte per block, row-major, at the level the layer's first missed-cone lookup
+    // reads last (missCone); a lookup inside the level reads blocks u < width - 1,
+    // v < height - 1, the last row and column stay 0; empty otherwise
+    std::vector<std::vector<uint8_t>> owned_empty_blocks;
     // The same for the layers' transparent planes (empty when the scene has no BLEND surface):
     // stored D of the nearest BLEND fragment (kEmptyDepth where none) and premultiplied mipmaps.
     std::vector<std::vector<float>> transparent_depth;
