@@ -143,27 +143,39 @@ constexpr uint32_t kLanes = 8; // cells per OneWindowBlock
 
 // The one-window merge of kLanes neighbouring cells inside an aperture level (no clamped
 // column): per lane the closest and farthest head over the taps (lo = -inf if a tap holds two
-// fragments or more) and the sums Σ w·FirstStep in tap order.
+// fragments or more) and, if some lane's heads fall into one window, the sums Σ w·FirstStep in
+// tap order.
 struct OneWindowBlock {
     uint32_t first = std::numeric_limits<uint32_t>::max(); // the block's first cell
     float v[kDense][kLanes];
 
-    // Taps `taps[k]` read dense box rows of `stride` floats per array at column i + dx.
+    // Taps `taps[k]` read dense box rows of `stride` floats per array at column i + dx. The
+    // sums are left out when no lane's taps fall into one window (dense foliage: most blocks).
     template <class RowTap>
-    void fill(uint32_t i, const RowTap* taps, uint32_t count, size_t stride) {
+    void fill(uint32_t i, const RowTap* taps, uint32_t count, size_t stride, float scale) {
         first = i;
         for (uint32_t l = 0; l < kLanes; ++l) {
             v[kLo][l] = std::numeric_limits<float>::infinity();
-            for (uint32_t c = kHi; c < kDense; ++c)
-                v[c][l] = 0.0f;
+            v[kHi][l] = 0.0f;
         }
         for (uint32_t k = 0; k < count; ++k) {
             const float* src = taps[k].dense + (int32_t(i) + taps[k].dx);
-            const float w = taps[k].w;
             for (uint32_t l = 0; l < kLanes; ++l) {
                 v[kLo][l] = std::min(v[kLo][l], src[kLo * stride + l]);
                 v[kHi][l] = std::max(v[kHi][l], src[kHi * stride + l]);
             }
+        }
+        bool any = false;
+        for (uint32_t l = 0; l < kLanes; ++l)
+            any = any || v[kHi][l] <= v[kLo][l] * scale;
+        if (!any)
+            return;
+        for (uint32_t c = kR; c < kDense; ++c)
+            for (uint32_t l = 0; l < kLanes; ++l)
+                v[c][l] = 0.0f;
+        for (uint32_t k = 0; k < count; ++k) {
+            const float* src = taps[k].dense + (int32_t(i) + taps[k].dx);
+            const float w = taps[k].w;
             for (uint32_t c = kR; c < kDense; ++c)
                 for (uint32_t l = 0; l < kLanes; ++l)
                     v[c][l] += w * src[c * stride + l];
@@ -585,7 +597,7 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
                 // sums without its loops. Empty taps add w·(+0) to sums that start at +0 and
                 // so are never -0: the same bytes.
                 if (i < block.first || i - block.first >= kLanes)
-                    block.fill(i, row_taps.data(), row_tap_count, box_width + kLanes);
+                    block.fill(i, row_taps.data(), row_tap_count, box_width + kLanes, scale);
                 const uint32_t l = i - block.first;
                 const float d0 = block.v[kLo][l];
                 const float limit = d0 * scale;
