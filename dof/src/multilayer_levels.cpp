@@ -54,25 +54,33 @@ void sumRows(const std::vector<uint32_t>& longest, const std::vector<uint64_t>& 
 
 // The taps of one cell, in merge order, empty lists left out (they would add w·0 = +0 to sums
 // that start at +0 and so are never -0: the same bytes).
-struct CellTaps {
+// With kSteps, each tap also carries its first fragment's FirstStep.
+template <bool kSteps> struct CellTaps {
     const LayerFragment* next[kMaxMergeLists];
     const LayerFragment* end[kMaxMergeLists];
     float weight[kMaxMergeLists];
+    const FirstStep* step[kSteps ? kMaxMergeLists : 1];
     uint32_t m = 0;
 
     void add(const LayerFragment* f, uint32_t count, float w) {
         next[m] = f, end[m] = f + count, weight[m] = w;
         ++m;
     }
+    void add(const LayerFragment* f, uint32_t count, float w, const FirstStep* s) {
+        step[m] = s;
+        add(f, count, w);
+    }
     // Appends the §5.1 merge of the taps (mergeListArrays) and consumes them.
     template <class Keep>
     void merge(const LevelPlan& plan, bool pieces, Keep&& keep, std::vector<LayerFragment>& out,
                uint64_t& dropped) {
         const float e = plan.epsilon;
+        const bool md = plan.mean_depth;
+        const FirstStep** s = kSteps ? step : nullptr;
         if (pieces)
-            mergeListArrays<true>(next, end, weight, m, e, plan.mean_depth, keep, out, dropped);
+            mergeListArrays<true, kSteps>(next, end, weight, m, e, md, keep, out, dropped, s);
         else
-            mergeListArrays<false>(next, end, weight, m, e, plan.mean_depth, keep, out, dropped);
+            mergeListArrays<false, kSteps>(next, end, weight, m, e, md, keep, out, dropped, s);
     }
 };
 
@@ -128,6 +136,52 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
     const auto every = [](uint32_t, uint32_t) { return true; };
     mergeCells(plan, borders, border_level, pool, out, every, row_merge);
 }
+
+// shapeLevel's dense box rows: kDense arrays per row (FragmentLevel::Scratch::dense).
+enum Dense : uint32_t { kLo, kHi, kR, kG, kB, kA, kD, kDense };
+constexpr uint32_t kLanes = 8; // cells per OneWindowBlock
+
+// The one-window merge of kLanes neighbouring cells inside an aperture level (no clamped
+// column): per lane the closest and farthest head over the taps (lo = -inf if a tap holds two
+// fragments or more) and, if some lane's heads fall into one window, the sums Σ w·FirstStep in
+// tap order.
+struct OneWindowBlock {
+    uint32_t first = std::numeric_limits<uint32_t>::max(); // the block's first cell
+    float v[kDense][kLanes];
+
+    // Taps `taps[k]` read dense box rows of `stride` floats per array at column i + dx. The
+    // sums are left out when no lane's taps fall into one window (dense foliage: most blocks).
+    template <class RowTap>
+    void fill(uint32_t i, const RowTap* taps, uint32_t count, size_t stride, float scale) {
+        first = i;
+        for (uint32_t l = 0; l < kLanes; ++l) {
+            v[kLo][l] = std::numeric_limits<float>::infinity();
+            v[kHi][l] = 0.0f;
+        }
+        for (uint32_t k = 0; k < count; ++k) {
+            const float* src = taps[k].dense + (int32_t(i) + taps[k].dx);
+            for (uint32_t l = 0; l < kLanes; ++l) {
+                v[kLo][l] = std::min(v[kLo][l], src[kLo * stride + l]);
+                v[kHi][l] = std::max(v[kHi][l], src[kHi * stride + l]);
+            }
+        }
+        bool any = false;
+        for (uint32_t l = 0; l < kLanes; ++l)
+            any = any || v[kHi][l] <= v[kLo][l] * scale;
+        if (!any)
+            return;
+        for (uint32_t c = kR; c < kDense; ++c)
+            for (uint32_t l = 0; l < kLanes; ++l)
+                v[c][l] = 0.0f;
+        for (uint32_t k = 0; k < count; ++k) {
+            const float* src = taps[k].dense + (int32_t(i) + taps[k].dx);
+            const float w = taps[k].w;
+            for (uint32_t c = kR; c < kDense; ++c)
+                for (uint32_t l = 0; l < kLanes; ++l)
+                    v[c][l] += w * src[c * stride + l];
+        }
+    }
+};
 
 void finishGeometry(FragmentLevel& level, uint32_t base_width, uint32_t base_height) {
     const double n = std::ldexp(1.0, int(level.index)); // 2^S point samples per axis
@@ -308,7 +362,7 @@ void filterLevel(const FragmentLevel& prev, const LevelPlan& plan, const LevelBo
             const int32_t y1 = std::clamp(mip ? 2 * int32_t(j) + 1 : int32_t(j), 0, max_y);
             const int32_t xs[4] = {x0, x1, x0, x1};
             const int32_t ys[4] = {y0, y0, y1, y1};
-            CellTaps taps;
+            CellTaps<false> taps;
             for (int k = 0; k < 4; ++k) {
                 uint32_t count = 0;
                 const LayerFragment* f = prev.list(uint32_t(xs[k]), uint32_t(ys[k]), count);
@@ -448,6 +502,49 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
         row_data[y] = box.rows[y].data();
     }
     const bool pieces = box.kind != LevelKind::Base;
+    // Every box fragment's FirstStep, row by row as the fragments: each is read by up to G²
+    // cells (and again in later windows), which would each compute it.
+    std::vector<size_t>& step_row = out.scratch.step_row;
+    std::vector<FirstStep>& steps = out.scratch.steps;
+    step_row.resize(size_t(box.height) + 1);
+    step_row[0] = 0;
+    for (uint32_t y = 0; y < box.height; ++y)
+        step_row[y + 1] = step_row[y] + box.rows[y].size();
+    steps.resize(step_row[box.height]);
+    pool.parallelFor(box.height, [&](uint32_t y, uint32_t) {
+        FirstStep* o = steps.data() + step_row[y];
+        for (const LayerFragment& f : box.rows[y])
+            *o++ = firstStep(f, pieces);
+    });
+    // Every box cell as the one-window sum below reads it, row by row: kDense arrays of
+    // box.width + kLanes floats (padded for the lanes past the last cell). A cell holding one
+    // fragment has its depth as both head bounds and its FirstStep; an empty cell adds +0 and
+    // leaves the bounds alone (lo = +inf, hi = 0); a cell of two or more fragments sets lo =
+    // -inf, which fails the test of one window.
+    const size_t dense_row = size_t(kDense) * (box_width + kLanes);
+    std::vector<float>& dense = out.scratch.dense;
+    dense.resize(dense_row * box.height);
+    pool.parallelFor(box.height, [&](uint32_t y, uint32_t) {
+        float* o = dense.data() + dense_row * y;
+        const size_t n = box_width + kLanes;
+        std::fill(o, o + n, std::numeric_limits<float>::infinity()); // kLo
+        std::fill(o + n, o + dense_row, 0.0f);                       // kHi, kR.. kD
+        const uint32_t* st = box.starts.data() + size_t(y) * (box_width + 1);
+        const FirstStep* fs = steps.data() + step_row[y];
+        for (uint32_t x = 0; x < box_width; ++x) {
+            const uint32_t count = st[x + 1] - st[x];
+            if (count == 0)
+                continue;
+            if (count > 1) {
+                o[kLo * n + x] = -std::numeric_limits<float>::infinity();
+                continue;
+            }
+            const FirstStep& f = fs[st[x]];
+            o[kLo * n + x] = o[kHi * n + x] = box.rows[y][st[x]].depth;
+            o[kR * n + x] = f.r, o[kG * n + x] = f.g, o[kB * n + x] = f.b;
+            o[kA * n + x] = f.a, o[kD * n + x] = f.depth;
+        }
+    });
     // The taps with weight, in grid order: box cell offsets from the cell (before clamping).
     struct Tap {
         int32_t dx = 0;
@@ -468,6 +565,8 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
         struct RowTap {
             const uint32_t* starts = nullptr;
             const LayerFragment* data = nullptr;
+            const FirstStep* steps = nullptr;
+            const float* dense = nullptr;
             int32_t dx = 0;
             float w = 0.0f;
         };
@@ -478,22 +577,50 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
             const int32_t y = std::clamp(int32_t(j) + int32_t(tap.row) * step - reach, 0, max_y);
             const uint32_t* st = row_starts[size_t(y)];
             if (st[0] != st[box_cells])
-                row_taps[row_tap_count++] = {st, row_data[size_t(y)], tap.dx, tap.w};
+                row_taps[row_tap_count++] = {st,
+                                             row_data[size_t(y)],
+                                             steps.data() + step_row[size_t(y)],
+                                             dense.data() + dense_row * size_t(y),
+                                             tap.dx,
+                                             tap.w};
         }
-        return [&, row_taps, row_tap_count](uint32_t i, auto& keep, std::vector<LayerFragment>& row,
-                                            uint64_t& dropped) {
-            // The taps with weight in grid order (a fixed merge order); empty lists are left
-            // out (CellTaps). Border cells clamped, as the stack's (Fig. 4); inside, no column
-            // is.
+        return [&, row_taps, row_tap_count,
+                block = OneWindowBlock{}](uint32_t i, auto& keep, std::vector<LayerFragment>& row,
+                                          uint64_t& dropped) mutable {
+            // Border cells clamped, as the stack's (Fig. 4); inside, no column is.
             const bool inside = int32_t(i) >= reach && int32_t(i) <= max_x;
-            CellTaps cell;
+            if (inside) {
+                // The one-window sums of this cell and the next kLanes - 1, computed together
+                // (lane by lane the same operations: the compiler vectorises them). A cell
+                // whose taps hold one fragment each, all in the first merge window (the common
+                // case), is that window's sum of first steps in tap order: mergeListArrays'
+                // sums without its loops. Empty taps add w·(+0) to sums that start at +0 and
+                // so are never -0: the same bytes.
+                if (i < block.first || i - block.first >= kLanes)
+                    block.fill(i, row_taps.data(), row_tap_count, box_width + kLanes, scale);
+                const uint32_t l = i - block.first;
+                const float d0 = block.v[kLo][l];
+                const float limit = d0 * scale;
+                if (block.v[kHi][l] <= limit) {
+                    LayerFragment merged;
+                    merged.r = block.v[kR][l], merged.g = block.v[kG][l];
+                    merged.b = block.v[kB][l], merged.a = block.v[kA][l];
+                    emitMerged(merged, block.v[kD][l], d0, limit, plan.mean_depth, keep, row,
+                               dropped);
+                    return;
+                }
+            }
+            // The taps with weight in grid order (a fixed merge order); empty lists are left
+            // out (CellTaps).
+            CellTaps<true> cell;
             for (uint32_t k = 0; k < row_tap_count; ++k) {
                 const RowTap& tap = row_taps[k];
                 const int32_t xt = int32_t(i) + tap.dx;
                 const uint32_t x = uint32_t(inside ? xt : std::clamp(xt, 0, max_x));
-                const uint32_t count = tap.starts[x + 1] - tap.starts[x];
+                const uint32_t first = tap.starts[x];
+                const uint32_t count = tap.starts[x + 1] - first;
                 if (count > 0)
-                    cell.add(tap.data + tap.starts[x], count, tap.w);
+                    cell.add(tap.data + first, count, tap.w, tap.steps + first);
             }
             cell.merge(plan, pieces, keep, row, dropped);
         };

@@ -44,6 +44,18 @@ struct LayerFragment {
     float depth = 0.0f; // distance along the view axis (world units), > 0
 };
 
+// The first step of a list's blend in a merge window (§5.1, "within one source list"): the
+// opacity so far is pa = 0 there, so fragment f adds (pr, pg, pb, pa, pd) = 0 + t·(αc, α, α·d)
+// with t = shareInList(f, pieces, 0), whatever the window and the cell (firstStep). A level
+// read by many cells (an aperture level's G x G taps) computes it once per fragment.
+struct FirstStep {
+    float r = 0.0f;
+    float g = 0.0f;
+    float b = 0.0f;
+    float a = 0.0f;
+    float depth = 0.0f; // t·α·d, for the mean depth
+};
+
 enum class LevelKind : uint8_t {
     Base,     // level 0: the collected lists (§4)
     Mip,      // 2x2 lists of the level below merged into one, half the resolution (§5.1)
@@ -102,6 +114,9 @@ struct FragmentLevel {
         std::vector<uint8_t> need;
         std::vector<const uint32_t*> row_starts;
         std::vector<const LayerFragment*> row_data;
+        std::vector<size_t> step_row; // shapeLevel: each box row's first FirstStep
+        std::vector<FirstStep> steps; // shapeLevel: the box fragments' first steps
+        std::vector<float> dense;     // shapeLevel: the box cells for one-window merges
     };
     Scratch scratch;
 
@@ -219,15 +234,41 @@ template <class Keep>
 void mergeLists(const ListRef* lists, uint32_t list_count, float epsilon, bool mean_depth,
                 Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped);
 
+// f's FirstStep: what it adds as the first fragment of its list in a merge window.
+inline FirstStep firstStep(const LayerFragment& f, bool pieces) {
+    const float t = shareInList(f, pieces, 0.0f);
+    // 0 + x as the blend's sums start (x = -0 gives +0).
+    return {0.0f + t * f.r, 0.0f + t * f.g, 0.0f + t * f.b, 0.0f + t * f.a,
+            0.0f + t * f.a * f.depth};
+}
+
 // mergeLists on lists given as arrays, the form the level stages hold a cell's taps in: list k
 // runs from next[k] (advanced past what is merged) to end[k] with weight[k], k < m <=
 // kMaxMergeLists, none of them empty, all pieces or all not (kPieces). mergeLists runs this
 // after leaving out its empty lists (they would add w·0 = +0 to sums that start at +0 and so are
-// never -0: the same bytes), so the unit tests of mergeLists test what the render runs.
-template <bool kPieces, class Keep>
+// never -0: the same bytes), so the unit tests of mergeLists test what the render runs. With
+// kSteps, step[k] is next[k]'s firstStep (advanced with it), used instead of computing it.
+template <bool kPieces, bool kSteps = false, class Keep>
 void mergeListArrays(const LayerFragment** next, const LayerFragment* const* end,
                      const float* weight, uint32_t m, float epsilon, bool mean_depth, Keep&& keep,
-                     std::vector<LayerFragment>& out, uint64_t& dropped);
+                     std::vector<LayerFragment>& out, uint64_t& dropped,
+                     const FirstStep** step = nullptr);
+
+// The end of one merge window: emits the merged fragment (Σ w α'c', Σ w α') at depth d0 or,
+// with mean_depth, at depth_sum / α clamped to [d0, limit], unless its opacity is 0 or keep
+// drops it (counted in dropped).
+template <class Keep>
+void emitMerged(LayerFragment merged, float depth_sum, float d0, float limit, bool mean_depth,
+                Keep&& keep, std::vector<LayerFragment>& out, uint64_t& dropped) {
+    if (!(merged.a > 0.0f))
+        return;
+    merged.depth = mean_depth ? std::clamp(depth_sum / merged.a, d0, limit) : d0;
+    if (!keep(merged.depth)) {
+        ++dropped;
+        return;
+    }
+    out.push_back(merged);
+}
 
 // Level 0 from the collected lists: premultiplies colour by opacity and converts stored depth D
 // to view distance. Fragments with zero opacity are dropped.
@@ -283,10 +324,10 @@ void shapeLevel(const FragmentLevel& box, const ApertureGrid& grid, const LevelP
 
 // ---------------------------------------------------------------------------------------------
 
-template <bool kPieces, class Keep>
+template <bool kPieces, bool kSteps, class Keep>
 void mergeListArrays(const LayerFragment** next, const LayerFragment* const* end,
                      const float* weight, uint32_t m, float epsilon, bool mean_depth, Keep&& keep,
-                     std::vector<LayerFragment>& out, uint64_t& dropped) {
+                     std::vector<LayerFragment>& out, uint64_t& dropped, const FirstStep** step) {
     static_assert(kMaxMergeLists <= 64);
     FOCAL_CHECK(m <= kMaxMergeLists);
     const float scale = 1.0f + epsilon;
@@ -307,22 +348,22 @@ void mergeListArrays(const LayerFragment** next, const LayerFragment* const* end
             const LayerFragment* f = next[k];
             if (!(f->depth <= limit))
                 continue;
-            // Within list k, front to back (§5.1, first case). A list of one fragment (the
-            // common case) takes its first step only, with pa = 0.
-            float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f, pd = 0.0f;
+            // Within list k, front to back (§5.1, first case). The first step has pa = 0; a
+            // list of one fragment (the common case) takes only that step.
+            const FirstStep s = kSteps ? *step[k] : firstStep(*f, kPieces);
+            float pr = s.r, pg = s.g, pb = s.b, pa = s.a, pd = s.depth;
             if (end[k] - f == 1) {
-                const float t = shareInList(*f, kPieces, 0.0f);
-                pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
-                pd += t * f->a * f->depth;
                 live &= ~(uint64_t{1} << k);
             } else {
-                do {
+                const LayerFragment* const first = f;
+                for (++f; f != end[k] && f->depth <= limit; ++f) {
                     const float t = shareInList(*f, kPieces, pa);
                     pr += t * f->r, pg += t * f->g, pb += t * f->b, pa += t * f->a;
                     pd += t * f->a * f->depth;
-                    ++f;
-                } while (f != end[k] && f->depth <= limit);
+                }
                 next[k] = f;
+                if constexpr (kSteps)
+                    step[k] += f - first;
                 if (f == end[k])
                     live &= ~(uint64_t{1} << k);
             }
@@ -331,14 +372,7 @@ void mergeListArrays(const LayerFragment** next, const LayerFragment* const* end
             merged.r += w * pr, merged.g += w * pg, merged.b += w * pb, merged.a += w * pa;
             depth_sum += w * pd;
         }
-        if (!(merged.a > 0.0f))
-            continue;
-        merged.depth = mean_depth ? std::clamp(depth_sum / merged.a, d0, limit) : d0;
-        if (!keep(merged.depth)) {
-            ++dropped;
-            continue;
-        }
-        out.push_back(merged);
+        emitMerged(merged, depth_sum, d0, limit, mean_depth, keep, out, dropped);
     }
 }
 

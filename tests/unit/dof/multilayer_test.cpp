@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -201,6 +202,81 @@ TEST(Multilayer, ShapeLevelMergesEveryCellItsReadsCanSee) {
             ASSERT_EQ(np, 1u) << i << "," << j;
             EXPECT_EQ(std::memcmp(f, p, sizeof(dof::LayerFragment)), 0) << i << "," << j;
             EXPECT_NEAR(p->depth, 1.025f, 1e-6f);
+        }
+}
+
+TEST(Multilayer, ShapeLevelMergesEachCellAsMergeListsDoes) {
+    // shapeLevel's one-window sums and its first steps (computed once per box fragment) must
+    // give mergeLists' bytes: a 13x9 box level of lists of 0-3 fragments (random depths and
+    // opacities, so cells fall into one window, several, or lists that span windows), read
+    // through a 4x4 grid with some weights 0, as a base level (over operator within a list)
+    // and as a filtered one (pieces), with both depth rules.
+    dof::FragmentLevel box;
+    box.width = 13;
+    box.height = 9;
+    box.rows.resize(box.height);
+    box.starts.assign(size_t(box.height) * (box.width + 1), 0);
+    uint32_t seed = 12345;
+    auto next = [&seed] {
+        seed = seed * 1664525u + 1013904223u;
+        return float(seed >> 8) / float(1u << 24);
+    };
+    for (uint32_t j = 0; j < box.height; ++j)
+        for (uint32_t i = 0; i < box.width; ++i) {
+            const uint32_t count = uint32_t(next() * 4.0f) % 4;
+            float d = 1.0f + next();
+            for (uint32_t k = 0; k < count; ++k) {
+                const float a = k == 0 && next() < 0.5f ? 1.0f : 0.1f + 0.9f * next();
+                box.rows[j].push_back({a * next(), a * next(), a * next(), a, d});
+                d *= 1.0f + 0.3f * next();
+            }
+            box.starts[j * (box.width + 1) + i + 1] = uint32_t(box.rows[j].size());
+        }
+    dof::ApertureGrid grid;
+    grid.size = 4;
+    grid.weight.assign(16, 0.0f);
+    float sum = 0.0f;
+    for (float& w : grid.weight) {
+        w = next() < 0.2f ? 0.0f : next();
+        sum += w;
+    }
+    for (float& w : grid.weight)
+        w /= sum;
+    raster::TaskPool pool(0);
+    for (const dof::LevelKind kind : {dof::LevelKind::Base, dof::LevelKind::Mip})
+        for (const bool mean_depth : {true, false}) {
+            box.kind = kind;
+            dof::LevelPlan plan;
+            plan.truncate = false;
+            plan.mean_depth = mean_depth;
+            dof::FragmentLevel level = dof::planApertureLevel(box, grid, 1, box.width, box.height);
+            dof::shapeLevel(box, grid, plan, {}, nullptr, pool, level);
+            const int32_t reach = int32_t(grid.size - 1);
+            for (uint32_t j = 0; j < level.height; ++j)
+                for (uint32_t i = 0; i < level.width; ++i) {
+                    dof::ListRef lists[dof::kMaxMergeLists];
+                    uint32_t n = 0;
+                    for (uint32_t b = 0; b < grid.size; ++b)
+                        for (uint32_t a = 0; a < grid.size; ++a) {
+                            if (!(grid.at(a, b) > 0.0f))
+                                continue;
+                            const int32_t x = std::clamp(int32_t(i + a) - reach, 0, 12);
+                            const int32_t y = std::clamp(int32_t(j + b) - reach, 0, 8);
+                            uint32_t count = 0;
+                            const dof::LayerFragment* f = box.list(uint32_t(x), uint32_t(y), count);
+                            lists[n++] = {f, count, grid.at(a, b), kind != dof::LevelKind::Base};
+                        }
+                    std::vector<dof::LayerFragment> want;
+                    uint64_t dropped = 0;
+                    dof::mergeLists(
+                        lists, n, plan.epsilon, mean_depth, [](float) { return true; }, want,
+                        dropped);
+                    uint32_t count = 0;
+                    const dof::LayerFragment* got = level.list(i, j, count);
+                    ASSERT_EQ(count, want.size()) << i << "," << j;
+                    EXPECT_EQ(std::memcmp(got, want.data(), count * sizeof(dof::LayerFragment)), 0)
+                        << i << "," << j;
+                }
         }
 }
 
