@@ -19,6 +19,24 @@ namespace {
 // Cone coverage at or above this ends the traversal (the cone is fully blocked, §4.4).
 constexpr float kFullCoverage = 0.999f;
 
+// A pixel's weighted sums of its rays' colours and of their weights, in double and in sample
+// order: four independent sums (the weight's as wt * 1, which is wt), so the compiler can keep
+// them in one vector register with the same bits as four scalars.
+struct RaySum {
+    double v[4] = {0.0, 0.0, 0.0, 0.0};
+    void add(float weight, glm::vec3 c) {
+        const double wt = double(weight);
+        const double in[4] = {double(c.r), double(c.g), double(c.b), 1.0};
+        for (int i = 0; i < 4; ++i)
+            v[i] += wt * in[i];
+    }
+    // The weighted mean into out[0..2] (sums with a positive weight).
+    void mean(float* out) const {
+        for (int i = 0; i < 3; ++i)
+            out[i] = float(v[i] / v[3]);
+    }
+};
+
 // The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
 LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
                           const std::array<float, 4>& noise, uint32_t halton_offset) {
@@ -168,17 +186,10 @@ bool inFocusPixel(const Tracer& tr, uint32_t x, uint32_t y, const PixelLayers& p
     }
     const raster::LayeredTarget& lt = *tr.layers;
     const glm::vec3 c(lt.color.load(lt.index(l, texel)));
-    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
-    for (uint32_t k = 0; k < tr.samples->size(); ++k) {
-        const double wt = double(tr.samples->sample(k).weight);
-        sum_r += wt * double(c.r);
-        sum_g += wt * double(c.g);
-        sum_b += wt * double(c.b);
-        sum_w += wt;
-    }
-    out[0] = float(sum_r / sum_w);
-    out[1] = float(sum_g / sum_w);
-    out[2] = float(sum_b / sum_w);
+    RaySum sum;
+    for (uint32_t k = 0; k < tr.samples->size(); ++k)
+        sum.add(tr.samples->sample(k).weight, c);
+    sum.mean(out);
     out[3] = 1.0f;
     cnt.rays += tr.samples->size();
     ++cnt.pixels_in_focus;
@@ -438,7 +449,7 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
               TileCounters& cnt, Rec& rec) {
     const MultiviewSettings& s = *tr.settings;
     const float t_last = tr.segs.back().t1;
-    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0, sum_w = 0.0;
+    RaySum sum;
     const uint32_t n = tr.samples->size();
     // No ray is recorded or discarded (the usual case): the weighted mean alone, as below.
     const bool plain = !Rec::kOn && s.offscreen != OffscreenPolicy::Discard;
@@ -449,11 +460,7 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
             ++cnt.background;
             color += ray.transmit * tr.background;
         }
-        const double wt = double(ray.lens.weight);
-        sum_r += wt * double(color.r);
-        sum_g += wt * double(color.g);
-        sum_b += wt * double(color.b);
-        sum_w += wt;
+        sum.add(ray.lens.weight, color);
     }
     for (uint32_t k = 0; !plain && k < n; ++k) {
         const RayState& ray = rays[k];
@@ -475,16 +482,10 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
             ++cnt.discarded; // the path to the hit leaves the image
             continue;
         }
-        const double wt = double(ray.lens.weight);
-        sum_r += wt * double(color.r);
-        sum_g += wt * double(color.g);
-        sum_b += wt * double(color.b);
-        sum_w += wt;
+        sum.add(ray.lens.weight, color);
     }
-    if (sum_w > 0.0) {
-        out[0] = float(sum_r / sum_w);
-        out[1] = float(sum_g / sum_w);
-        out[2] = float(sum_b / sum_w);
+    if (sum.v[3] > 0.0) {
+        sum.mean(out);
     } else { // every ray left the image: the pinhole colour
         const size_t i = (size_t(y) * tr.width + x) * 4;
         out[0] = tr.pinhole->color[i];
