@@ -408,6 +408,10 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         const LayersFn render_layers = [this, &call](const raster::View& v,
                                                      const raster::LayeredTargetDesc& d,
                                                      raster::LayeredTarget& t) {
+            // The pinhole was rendered just before from the same eye (unless it was kept from
+            // pinhole()): its geometry and bins serve the layers too.
+            if (!call.report.pinhole_reused)
+                renderer_->promiseSceneUnchanged();
             return renderer_->renderLayers(call.scene, v, call.options, d, t);
         };
         raster::Result<MultiviewStats> r = renderMultiview(

@@ -38,7 +38,27 @@ struct Renderer::State {
     std::vector<uint64_t> list_hidden;
     // Layered rendering: the overlapped interval of each layer.
     std::vector<LayerInterval> layer_intervals;
+    // What the geometry and bins were made from (prepared: they are complete), and the
+    // caller's promise for the next call that the scene is unchanged since
+    // (promiseSceneUnchanged).
+    struct {
+        bool prepared = false;
+        const Scene* scene = nullptr;
+        View view;
+        uint32_t tile_size = 0;
+    } made;
+    bool scene_unchanged = false;
 };
+
+namespace {
+// Every field, exactly: the geometry and bins depend on all of them.
+bool sameView(const View& a, const View& b) {
+    return a.eye == b.eye && a.forward == b.forward && a.right == b.right && a.up == b.up &&
+           a.yfov == b.yfov && a.width == b.width && a.height == b.height && a.znear == b.znear &&
+           a.zfar == b.zfar && a.lens_offset == b.lens_offset &&
+           a.focus_distance == b.focus_distance && a.pixel_shift == b.pixel_shift;
+}
+} // namespace
 
 Renderer::Renderer(TaskPool& pool) : pool_(pool), state_(std::make_unique<State>()) {}
 Renderer::~Renderer() = default;
@@ -116,7 +136,7 @@ void Renderer::tileTriangleCounts(std::vector<uint32_t>& out, uint32_t& tiles_x,
 }
 
 Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptions& options,
-                         FrameStats* stats) {
+                         bool scene_unchanged, FrameStats* stats) {
     if (Status s = validate(options); !s.ok())
         return s;
     if (Status s = validate(view); !s.ok())
@@ -124,15 +144,21 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     if (Status s = validateTextures(scene, options.shading); !s.ok())
         return s;
     State& st = *state_;
-    auto t0 = std::chrono::steady_clock::now();
-    runGeometry(pool_, scene, view, st.geometry);
-    const double ms_geometry = msSince(t0);
-
-    t0 = std::chrono::steady_clock::now();
+    const bool reuse = scene_unchanged && st.made.prepared && st.made.scene == &scene &&
+                       sameView(st.made.view, view) && st.made.tile_size == options.tile_size;
     st.ctx = RasterContext{};
     st.ctx.grid = makeTileGrid(view.width, view.height, options.tile_size);
-    binChunks(pool_, st.geometry, st.ctx.grid, st.bins);
-    const double ms_binning = msSince(t0);
+    double ms_geometry = 0.0, ms_binning = 0.0;
+    if (!reuse) {
+        st.made.prepared = false; // until both are complete
+        auto t0 = std::chrono::steady_clock::now();
+        runGeometry(pool_, scene, view, st.geometry);
+        ms_geometry = msSince(t0);
+        t0 = std::chrono::steady_clock::now();
+        binChunks(pool_, st.geometry, st.ctx.grid, st.bins);
+        ms_binning = msSince(t0);
+        st.made = {true, &scene, view, options.tile_size};
+    }
 
     st.ctx.geometry = &st.geometry;
     st.ctx.bins = &st.bins;
@@ -219,6 +245,7 @@ Status outOfMemory(const std::string& what) {
 
 Status Renderer::render(const Scene& scene, const View& view, const RenderOptions& options,
                         Frame& out, FrameStats* stats) try {
+    const bool unchanged = std::exchange(state_->scene_unchanged, false); // this call's only
     if (Status s = validate(view); !s.ok())
         return s;
     if (Status s = checkMemory(
@@ -227,7 +254,7 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
             frameBytes(view.width, view.height, options.depth_format, hasBlendMaterial(scene)));
         !s.ok())
         return s;
-    if (Status s = prepare(scene, view, options, stats); !s.ok())
+    if (Status s = prepare(scene, view, options, unchanged, stats); !s.ok())
         return s;
     State& st = *state_;
     out.width = view.width;
@@ -263,9 +290,14 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
     return outOfMemory("a " + sizeText(view) + " frame");
 }
 
+void Renderer::promiseSceneUnchanged() {
+    state_->scene_unchanged = true;
+}
+
 Status Renderer::renderLayers(const Scene& scene, const View& view, const RenderOptions& options,
                               const LayeredTargetDesc& desc, LayeredTarget& out,
                               FrameStats* stats) try {
+    const bool unchanged = std::exchange(state_->scene_unchanged, false); // this call's only
     if (Status s = validate(desc); !s.ok())
         return s;
     if (Status s = validate(view); !s.ok())
@@ -281,7 +313,7 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
                                hasBlendMaterial(scene)));
         !s.ok())
         return s;
-    if (Status s = prepare(scene, view, options, stats); !s.ok())
+    if (Status s = prepare(scene, view, options, unchanged, stats); !s.ok())
         return s;
     State& st = *state_;
     const uint32_t layers = uint32_t(desc.bounds.size() - 1);
@@ -369,6 +401,7 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
 Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                                      const RenderOptions& options, const FragmentListDesc& desc,
                                      FragmentLists& out, FrameStats* stats) try {
+    const bool unchanged = std::exchange(state_->scene_unchanged, false); // this call's only
     if (desc.node_capacity == 0)
         return Status::error("fragment list node capacity must be at least 1");
     if (!(desc.hidden_epsilon >= 0.0f) || !std::isfinite(desc.hidden_epsilon))
@@ -382,7 +415,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
             mulBytes(uint64_t(view.width) * view.height, 12));
         !s.ok())
         return s;
-    if (Status s = prepare(scene, view, options, stats); !s.ok())
+    if (Status s = prepare(scene, view, options, unchanged, stats); !s.ok())
         return s;
     State& st = *state_;
     const uint32_t tiles = st.ctx.grid.count();

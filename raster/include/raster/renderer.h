@@ -94,14 +94,24 @@ public:
                                const FragmentListDesc& desc, FragmentLists& out,
                                FrameStats* stats = nullptr);
 
+    // The next render call (any kind) reuses the last call's geometry and bins (transform,
+    // clipping, culling, setup, binning) when its scene, view and tile size are the last
+    // call's, instead of making them again: the caller promises that the scene has not changed
+    // since that call, which the Renderer cannot see. For a caller that renders one scene twice
+    // from the same eye, as multiview renders a pinhole and then its layers (Lee et al. §4.1,
+    // §4.2). The promise holds for the next call only.
+    void promiseSceneUnchanged();
+
     // Triangles binned to each tile by the last render call (any kind), summed over the geometry
     // chunks, row-major over `tiles_x` x `tiles_y` tiles of options.tile_size pixels: the binning
     // stage's load per tile, for looking inside (focal steps). Resizes `out`.
     void tileTriangleCounts(std::vector<uint32_t>& out, uint32_t& tiles_x, uint32_t& tiles_y) const;
 
 private:
+    // Geometry and bins for this call (kept from the last one when scene_unchanged and its
+    // scene, view and tile size are the same), and the raster context.
     Status prepare(const Scene& scene, const View& view, const RenderOptions& options,
-                   FrameStats* stats);
+                   bool scene_unchanged, FrameStats* stats);
     struct State;
     TaskPool& pool_;
     std::unique_ptr<State> state_;

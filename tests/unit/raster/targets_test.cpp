@@ -229,6 +229,45 @@ TEST(LayeredTarget, HalfAndUnorm16StorageStayWithinTheirPrecision) {
     }
 }
 
+// Renderer::promiseSceneUnchanged: the layers after a pinhole of the same scene and eye reuse its
+// geometry and bins, with the bytes of a fresh render; a different eye, or a promise spent on a
+// failed call, makes them again.
+TEST(LayeredTarget, GeometryIsKeptOnlyWhenPromisedForTheSameSceneAndView) {
+    raster::Scene s = stackScene(true);
+    const raster::View v = stackView();
+    const raster::LayeredTargetDesc desc = stackDesc(LayerRouting::MaxVertexDepth, 0.1f);
+    raster::TaskPool pool(0);
+    raster::Renderer r(pool);
+    raster::Frame pinhole;
+    raster::LayeredTarget out;
+    raster::FrameStats stats;
+
+    ASSERT_TRUE(r.render(s, v, {}, pinhole).ok());
+    r.promiseSceneUnchanged();
+    ASSERT_TRUE(r.renderLayers(s, v, {}, desc, out, &stats).ok());
+    EXPECT_EQ(hashLayers(out), hashLayers(layers(s, v, desc)));
+    EXPECT_EQ(stats.ms_geometry, 0.0); // kept, not made
+    EXPECT_GT(stats.triangles_setup, 0u);
+
+    raster::View moved = v;
+    moved.eye.x += 0.3f;
+    ASSERT_TRUE(r.render(s, v, {}, pinhole).ok());
+    r.promiseSceneUnchanged();
+    ASSERT_TRUE(r.renderLayers(s, moved, {}, desc, out).ok());
+    EXPECT_EQ(hashLayers(out), hashLayers(layers(s, moved, desc)));
+    EXPECT_NE(hashLayers(out), hashLayers(layers(s, v, desc)));
+
+    // A promise is for the next call only, even when that call fails.
+    ASSERT_TRUE(r.render(s, v, {}, pinhole).ok());
+    r.promiseSceneUnchanged();
+    raster::LayeredTargetDesc bad = desc;
+    bad.overlap = 2.0f;
+    ASSERT_FALSE(r.renderLayers(s, v, {}, bad, out).ok());
+    s.instances[0].world[3].x += 0.5f; // the caller changes the scene afterwards
+    ASSERT_TRUE(r.renderLayers(s, v, {}, desc, out).ok());
+    EXPECT_EQ(hashLayers(out), hashLayers(layers(s, v, desc)));
+}
+
 TEST(LayeredTarget, InvalidBoundsAreErrors) {
     raster::TaskPool pool(0);
     raster::Renderer r(pool);
