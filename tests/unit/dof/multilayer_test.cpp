@@ -156,22 +156,31 @@ TEST(Multilayer, MergeCarriesTheMeanDepthOfWhatItMerged) {
     EXPECT_LE(out[0].depth, out[1].depth);
 }
 
+// A level of width x height cells, row by row; fill(i, j, row) appends cell (i, j)'s list.
+template <class Fill> dof::FragmentLevel levelOf(uint32_t width, uint32_t height, Fill&& fill) {
+    dof::FragmentLevel level;
+    level.width = width;
+    level.height = height;
+    level.rows.resize(height);
+    level.starts.assign(size_t(height) * (width + 1), 0);
+    for (uint32_t j = 0; j < height; ++j)
+        for (uint32_t i = 0; i < width; ++i) {
+            fill(i, j, level.rows[j]);
+            level.starts[j * (width + 1) + i + 1] = uint32_t(level.rows[j].size());
+        }
+    return level;
+}
+
 TEST(Multilayer, ShapeLevelMergesEveryCellItsReadsCanSee) {
     // A 6x4 base whose columns alternate between depths 0.95 and 1.1, read through a 2x2 grid:
     // cells 1-5 merge one of each (ε = 0.2) into a fragment at their mean depth, 1.025,
     // although neither lies in the depths read, [1, 1.05). Those cells must still be merged,
     // as in the full level; column 0 lies outside the cells read and column 6 (two clamped
     // taps at 1.1) holds nothing read: both are left empty.
-    dof::FragmentLevel base;
-    base.width = 6;
-    base.height = 4;
-    base.rows.resize(base.height);
-    base.starts.assign(size_t(base.height) * (base.width + 1), 0);
-    for (uint32_t j = 0; j < base.height; ++j)
-        for (uint32_t i = 0; i < base.width; ++i) {
-            base.rows[j].push_back(frag(0.5f, 1.0f, i % 2 ? 1.1f : 0.95f));
-            base.starts[j * (base.width + 1) + i + 1] = i + 1;
-        }
+    const dof::FragmentLevel base =
+        levelOf(6, 4, [](uint32_t i, uint32_t, std::vector<dof::LayerFragment>& cell) {
+            cell.push_back(frag(0.5f, 1.0f, i % 2 ? 1.1f : 0.95f));
+        });
     dof::ApertureGrid grid;
     grid.size = 2;
     grid.weight = {0.25f, 0.25f, 0.25f, 0.25f};
@@ -211,27 +220,21 @@ TEST(Multilayer, ShapeLevelMergesEachCellAsMergeListsDoes) {
     // opacities, so cells fall into one window, several, or lists that span windows), read
     // through a 4x4 grid with some weights 0, as a base level (over operator within a list)
     // and as a filtered one (pieces), with both depth rules.
-    dof::FragmentLevel box;
-    box.width = 13;
-    box.height = 9;
-    box.rows.resize(box.height);
-    box.starts.assign(size_t(box.height) * (box.width + 1), 0);
     uint32_t seed = 12345;
     auto next = [&seed] {
         seed = seed * 1664525u + 1013904223u;
         return float(seed >> 8) / float(1u << 24);
     };
-    for (uint32_t j = 0; j < box.height; ++j)
-        for (uint32_t i = 0; i < box.width; ++i) {
+    dof::FragmentLevel box =
+        levelOf(13, 9, [&](uint32_t, uint32_t, std::vector<dof::LayerFragment>& cell) {
             const uint32_t count = uint32_t(next() * 4.0f) % 4;
             float d = 1.0f + next();
             for (uint32_t k = 0; k < count; ++k) {
                 const float a = k == 0 && next() < 0.5f ? 1.0f : 0.1f + 0.9f * next();
-                box.rows[j].push_back({a * next(), a * next(), a * next(), a, d});
+                cell.push_back({a * next(), a * next(), a * next(), a, d});
                 d *= 1.0f + 0.3f * next();
             }
-            box.starts[j * (box.width + 1) + i + 1] = uint32_t(box.rows[j].size());
-        }
+        });
     dof::ApertureGrid grid;
     grid.size = 4;
     grid.weight.assign(16, 0.0f);
