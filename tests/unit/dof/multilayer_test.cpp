@@ -277,10 +277,11 @@ TEST(Multilayer, ShapeLevelMergesEachCellAsMergeListsDoes) {
                     uint32_t count = 0;
                     const dof::LayerFragment* got = level.list(i, j, count);
                     ASSERT_EQ(count, want.size()) << i << "," << j;
-                    if (count > 0) // an empty list may have no storage (memcmp takes no null)
+                    if (count > 0) { // an empty list may have no storage (memcmp takes no null)
                         EXPECT_EQ(std::memcmp(got, want.data(), count * sizeof(dof::LayerFragment)),
                                   0)
                             << i << "," << j;
+                    }
                 }
         }
 }
