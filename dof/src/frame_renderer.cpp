@@ -335,7 +335,9 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
     }
 
     if (const GatherMethod* m = std::get_if<GatherMethod>(&method)) {
-        GatherSettings settings = m->settings;
+        // Kept: a probe of the frame gathers with the same settings (frame_stages.cpp).
+        GatherSettings& settings = gather_settings_;
+        settings = m->settings;
         settings.tile_size = options.tile_size;
         settings.simd = options.simd;
         if (Status s = validate(settings); !s.ok())
@@ -345,11 +347,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         if (Status s = sharedPinhole(); !s.ok())
             return s;
         const double ms_render = msSince(t0);
-        GatherImage in;
-        in.rgba = pinhole_.color.data();
-        in.depth = depthRefOf(pinhole_.depth);
-        in.width = pinhole_.width;
-        in.height = pinhole_.height;
+        const GatherImage in = gatherImageOf(pinhole_);
         std::vector<float>* coc_out =
             m->coc_out || !observer ? m->coc_out : &observedCoc(); // the stages show it
         raster::Result<GatherStats> r =

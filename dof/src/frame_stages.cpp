@@ -274,18 +274,9 @@ Status FrameRenderer::probeMethod(const raster::Scene& scene, const raster::View
         probe.method = observation().accum_probes.at(index);
         return {};
     }
-    if (const GatherMethod* m = std::get_if<GatherMethod>(&method)) {
-        GatherSettings settings = m->settings; // as renderFrame derived them
-        settings.tile_size = options.tile_size;
-        settings.simd = options.simd;
-        GatherImage in;
-        in.rgba = pinhole_.color.data();
-        in.depth = depthRefOf(pinhole_.depth);
-        in.width = pinhole_.width;
-        in.height = pinhole_.height;
-        return probeGather(in, lens, pinholeView(view), settings, gather_scratch_, x, y,
-                           probe.method.emplace<GatherPixelProbe>());
-    }
+    if (std::holds_alternative<GatherMethod>(method))
+        return probeGather(gatherImageOf(pinhole_), lens, pinholeView(view), gather_settings_,
+                           gather_scratch_, x, y, probe.method.emplace<GatherPixelProbe>());
     if (const MultiviewMethod* m = std::get_if<MultiviewMethod>(&method)) {
         ShadingInputs shading;
         shading.scene = &scene;

@@ -324,6 +324,15 @@ StoredDepthRef depthRefOf(const raster::DepthBuffer& depth) {
     return r;
 }
 
+GatherImage gatherImageOf(const raster::Frame& frame) {
+    GatherImage in;
+    in.rgba = frame.color.data();
+    in.depth = depthRefOf(frame.depth);
+    in.width = frame.width;
+    in.height = frame.height;
+    return in;
+}
+
 CocAffine cocAffine(const ThinLens& lens, const raster::View& view) {
     // Eq. 7 gives z from z'/w'; here D = -(1/d - 1/f) / (1/n - 1/f) (camera.h), i.e. 1/d = 1/f -
     // D (1/n - 1/f). Substituted into C(d) = E f_px (1/d_f - 1/d) (Eq. 2 in pixels, lens.h) this

@@ -82,17 +82,18 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
 // zero coverages (MultiviewScratch::owned_empty_blocks). False when unsure.
 inline bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float px, float py,
                        MipLevel lv) {
+    // The 2x2 block at level L under (px, py), false when the taps there are not all inside.
     int64_t block = 0;
-    for (const uint32_t level : {lv.l0, lv.l1}) {
+    const auto inside = [&](uint32_t level) {
         const MipView& m = mip[level];
         const float scale = kMipScale[level];
         const float fu = std::floor(px * scale - 0.5f), fv = std::floor(py * scale - 0.5f);
-        if (!(fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v))
-            return false;
         block = int64_t(fv) * m.width + int64_t(fu);
-        if (lv.l1 == lv.l0 || lv.f == 0.0f)
-            break; // sampleMip reads l0 only
-    }
+        return fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v;
+    };
+    const uint32_t last = lastConeLevel(lv);
+    if (!inside(lv.l0) || (last != lv.l0 && !inside(last)))
+        return false;
     return empty_blocks[block] != 0;
 }
 

@@ -50,16 +50,6 @@ struct Renderer::State {
     bool scene_unchanged = false;
 };
 
-namespace {
-// Every field, exactly: the geometry and bins depend on all of them.
-bool sameView(const View& a, const View& b) {
-    return a.eye == b.eye && a.forward == b.forward && a.right == b.right && a.up == b.up &&
-           a.yfov == b.yfov && a.width == b.width && a.height == b.height && a.znear == b.znear &&
-           a.zfar == b.zfar && a.lens_offset == b.lens_offset &&
-           a.focus_distance == b.focus_distance && a.pixel_shift == b.pixel_shift;
-}
-} // namespace
-
 Renderer::Renderer(TaskPool& pool) : pool_(pool), state_(std::make_unique<State>()) {}
 Renderer::~Renderer() = default;
 
@@ -145,7 +135,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
         return s;
     State& st = *state_;
     const bool reuse = scene_unchanged && st.made.prepared && st.made.scene == &scene &&
-                       sameView(st.made.view, view) && st.made.tile_size == options.tile_size;
+                       st.made.view == view && st.made.tile_size == options.tile_size;
     st.ctx = RasterContext{};
     st.ctx.grid = makeTileGrid(view.width, view.height, options.tile_size);
     double ms_geometry = 0.0, ms_binning = 0.0;

@@ -230,6 +230,7 @@ private:
     std::optional<LensSampleSet> sequence_2n_; // multiview's §4.5 Halton set
     Multilayer multilayer_;
     MultilayerImage multilayer_image_;
+    GatherSettings gather_settings_;         // the frame's, with tile size and simd (probes)
     MultiviewSettings multiview_settings_;   // the frame's, with seed and sequence_2n (probes)
     MultilayerSettings multilayer_settings_; // the frame's, with what the frame renderer fills in
     FrameReport report_;                     // the report of a render() call given none

@@ -20,6 +20,7 @@
 #include <dof/lens.h>
 #include <dof/settings_table.h>
 #include <raster/camera.h>
+#include <raster/frame.h>
 #include <raster/status.h>
 #include <raster/storage.h>
 #include <raster/task_pool.h>
@@ -50,6 +51,8 @@ struct GatherImage {
     uint32_t width = 0;
     uint32_t height = 0;
 };
+// The view of a raster::Frame's colour and depth (the frame must outlive it).
+GatherImage gatherImageOf(const raster::Frame& frame);
 
 // §4.1 rewritten for focal: the stored depth is D = -(1/d - 1/f) / (1/n - 1/f) (the window-space
 // z'/w' of Eq. 4 mapped to [-1, 0], reversed-Z with the sign flipped), so 1/d = 1/f - D (1/n - 1/f)

@@ -38,6 +38,9 @@ struct View {
     glm::vec2 lens_offset{0.0f};
     float focus_distance = 1.0f;
     glm::vec2 pixel_shift{0.0f}; // pixels, +x right, +y down
+
+    // Every field equal (bit for bit, but -0 == +0): the same projection and image.
+    friend bool operator==(const View&, const View&) = default;
 };
 
 // Focal length in pixels: f_px = (H/2) / tan(yfov/2).
