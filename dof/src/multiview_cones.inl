@@ -75,13 +75,13 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
 }
 
 // Whether sampleMip on `mip` (Stride channels per texel, a non-negative coverage in one channel)
-// at (px, py) on the levels lv returns exactly 0 in that channel because every texel it reads is
-// empty there: when both levels' taps lie inside their levels, the taps of the finer level l0
+// at (px, py) on levels whose finer one is l0 returns exactly 0 in that channel because every
+// texel it reads is empty there: when both levels' taps lie inside their levels, the taps of l0
 // lie in the 2x2 blocks the coarser level's four taps average (u0 = 2 u1 + 1/2), so the block
-// of the last level read (lastConeLevel) decides it: `empty_blocks` says which blocks have four
-// zero coverages (MultiviewScratch::owned_empty_blocks). False when unsure.
+// of the last level read (`last`, lastConeLevel) decides it: `empty_blocks` says which blocks
+// have four zero coverages (MultiviewScratch::owned_empty_blocks). False when unsure.
 inline bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float px, float py,
-                       MipLevel lv) {
+                       uint32_t l0, uint32_t last) {
     // The 2x2 block at level L under (px, py), false when the taps there are not all inside.
     int64_t block = 0;
     const auto inside = [&](uint32_t level) {
@@ -91,8 +91,7 @@ inline bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float p
         block = int64_t(fv) * m.width + int64_t(fu);
         return fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v;
     };
-    const uint32_t last = lastConeLevel(lv);
-    if (!inside(lv.l0) || (last != lv.l0 && !inside(last)))
+    if (!inside(l0) || (last != l0 && !inside(last)))
         return false;
     return empty_blocks[block] != 0;
 }
@@ -151,7 +150,7 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float c
         return std::nullopt;
     const MipChain& owned = tr.owned_mips[l];
     // Most rays pass where the layer owns nothing near them: no coverage, no lookup.
-    if (mipEmptyAt(owned, seg.cone_empty_blocks, px, py, seg.cone_level))
+    if (mipEmptyAt(owned, seg.cone_empty_blocks, px, py, seg.cone_level.l0, seg.cone_last_level))
         return std::nullopt;
     const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(owned, px, py, seg.cone_level);
     if (!(d[1] > 0.0f))

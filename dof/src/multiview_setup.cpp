@@ -220,6 +220,7 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
         for (LayerSeg& seg : tr.segs)
             if (seg.cone_px > 0.0f) {
                 seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
+                seg.cone_last_level = lastConeLevel(seg.cone_level);
                 seg.first_cone_px = tr.r_max * std::fabs(tr.cocOf(seg.t_cone)) +
                                     1.5f * std::ldexp(1.0f, int(seg.cone_level.l1)) + 1.0f;
             }
@@ -278,7 +279,7 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
                 if (tr.segs[l].cone_px > 0.0f) {
                     // mipEmptyAt's four coverage taps, tested once per block here instead of
                     // once per missed ray: one byte read, from a map that stays in the cache.
-                    const uint32_t lv = lastConeLevel(tr.segs[l].cone_level);
+                    const uint32_t lv = tr.segs[l].cone_last_level;
                     const size_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
                     const float* cov = scratch.owned_mips[l][lv].data() + 1;
                     const size_t row = w * kOwnedChannels;

@@ -12,6 +12,7 @@
 #include <raster/simd.h>
 
 #include <bit>
+#include <limits>
 
 namespace dof::multiview_detail {
 namespace {
@@ -36,6 +37,17 @@ struct RaySum {
             out[i] = float(v[i] / v[3]);
     }
 };
+
+// std::nextafter(x, INFINITY) inline (the library call is a tenth of a partial cone's cost): the
+// next float up, by one step of the bit pattern away from zero (x > 0) or towards it (x < 0).
+float nextUp(float x) {
+    if (!(x < INFINITY))
+        return x; // +infinity and NaN
+    if (x == 0.0f)
+        return std::numeric_limits<float>::denorm_min(); // from +0 and -0
+    const uint32_t bits = std::bit_cast<uint32_t>(x);
+    return std::bit_cast<float>(x > 0.0f ? bits + 1 : bits - 1);
+}
 
 // The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
 LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
@@ -251,6 +263,7 @@ struct PixelLayer {
     uint32_t x = 0, y = 0;
     float cx = 0.0f, cy = 0.0f; // the pixel's centre
     bool hittable = false;      // PixelLayers::hittable
+    bool cones = false;         // PixelLayers::cones
     bool paths_inside = false;  // every path of the layer lies in the image around the pixel
 
     void setLayer(const Tracer& tr, uint32_t layer) {
@@ -261,10 +274,11 @@ struct PixelLayer {
         paths = tr.paths.empty() ? nullptr : tr.paths.data() + l;
         path_stride = tr.segs.size();
     }
-    void setPixel(const Tracer& tr, uint32_t px, uint32_t py, bool can_hit) {
+    void setPixel(const Tracer& tr, uint32_t px, uint32_t py, const PixelLayers& pls) {
         x = px, y = py;
         cx = float(x) + 0.5f, cy = float(y) + 0.5f;
-        hittable = can_hit;
+        hittable = (pls.hittable >> l) & 1;
+        cones = (pls.cones >> l) & 1;
         const auto& box = seg->paths_box;
         paths_inside = paths && box.x0 <= box.x1 && int64_t(x) + box.x0 >= 0 &&
                        int64_t(y) + box.y0 >= 0 && int64_t(x) + box.x1 < int64_t(tr.width) &&
@@ -351,7 +365,7 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
     // A ray that crossed the whole segment without a hit still has a cone (missCone),
     // composited in depth order with the transparent plane.
     std::optional<MissCone> miss;
-    if (!h.hit && seg.cone_px > 0.0f && s0 == seg.t0)
+    if (!h.hit && pl.cones && s0 == seg.t0)
         miss = missCone(tr, l, cx, cy, wc, shade, shade_from, cnt);
     auto addMiss = [&] {
         if (blend(miss->v1, miss->c1))
@@ -439,7 +453,7 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
     // Resume a thousandth of the segment behind the slab, and at least one float step: stored
     // depth D = -n/d has the scale of n/d (camera.h), so an absolute nudge would skip whole
     // scenes under a tiny near plane.
-    ray.t_resume = std::nextafter(h.t_behind + 1e-3f * (seg.t1 - seg.t0), INFINITY);
+    ray.t_resume = nextUp(h.t_behind + 1e-3f * (seg.t1 - seg.t0));
 }
 
 // The end of pixel (x, y)'s rays: the background behind them, the paths that left the image
@@ -540,7 +554,7 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                 const size_t p = size_t(y - y0) * tw + (x - x0);
                 if (!((pixel_layers[p].active >> l) & 1))
                     continue;
-                pxl.setPixel(tr, x, y, (pixel_layers[p].hittable >> l) & 1);
+                pxl.setPixel(tr, x, y, pixel_layers[p]);
                 RayState* pr = rays + p * n;
                 const bool plain = !pxl.shade && !pxl.seg->transparent;
                 uint32_t live = 0;

@@ -63,6 +63,7 @@ struct LayerSeg {
     float t_cone = 0.0f, cone_px = 0.0f;
     float coc_cone = 0.0f; // C(t_cone): the same for every ray, so computed once
     MipLevel cone_level;   // the levels of that first lookup (its diameter is lambda |C(t_cone)|)
+    uint32_t cone_last_level = 0; // lastConeLevel(cone_level)
     // MultiviewScratch::owned_empty_blocks of the layer (null without missed cones)
     const uint8_t* cone_empty_blocks = nullptr;
     // Every ray's first lookup reads texels within first_cone_px of its pixel's centre: the ray
@@ -270,6 +271,7 @@ inline CellBox cellBox(glm::vec2 o0, glm::vec2 o1) {
 struct PixelLayers {
     uint64_t active = 0;   // not culled for the pixel (§4.3): its rays or missed cones may meet it
     uint64_t hittable = 0; // its rays can hit it at all (else only the cones see it)
+    uint64_t cones = 0;    // its rays' missed cones may see something there (missCone)
     bool resolved = false; // in focus, written without tracing (inFocusPixel)
 };
 

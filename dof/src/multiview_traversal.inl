@@ -255,18 +255,18 @@ PixelLayers pixelLayers(const Tracer& tr, uint32_t x, uint32_t y, const uint32_t
             continue;
         }
         const bool hittable = !s.culling || cone_px == 0.0f || !culledAt(tr, l, culls[i].ray, x, y);
-        if (!hittable) {
-            // Only the missed cones can see this layer. Their first lookup (missCone) reads
-            // within first_cone_px of the pixel centre (clamped to the image, so nearer to it)
-            // and finds coverage only where the layer owns a texel (depth <= own1): when none
-            // is there, the layer holds nothing for this pixel. (Not asked of hittable layers:
-            // the query costs more than the lookups it saves there.)
-            if (culledAt(tr, l, culls[i].first_cone, x, y)) {
-                ++cnt.culled_pixel;
-                continue;
-            }
+        // The missed cones' first lookup (missCone) reads within first_cone_px of the pixel
+        // centre (clamped to the image, so nearer to it) and finds coverage only where the
+        // layer owns a texel (depth <= own1): when none is there, no missed cone of the pixel
+        // sees anything in the layer, and a layer only cones could see holds nothing for it.
+        const bool cones =
+            cone_px > 0.0f && (!s.culling || !culledAt(tr, l, culls[i].first_cone, x, y));
+        if (!hittable && !cones) {
+            ++cnt.culled_pixel;
+            continue;
         }
         pl.hittable |= uint64_t(hittable) << l;
+        pl.cones |= uint64_t(cones) << l;
         pl.active |= uint64_t(1) << l;
     }
     return pl;
