@@ -128,10 +128,10 @@ struct MissCone {
 // image border under OffscreenPolicy::Clamp (the border texels stand in for the unseen content,
 // as for a clamped hit) and not at all under Discard; the culling windows, clamped to the
 // image, then still hold every texel read. None when the cone sees nothing. w: the cone centre's
-// image offset per unit C (the ray's, or its cell's with ConeCentre::Cell).
-std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, float cx, float cy, glm::vec2 w,
-                                 bool shade, glm::vec3 eye, TileCounters& cnt) {
-    const LayerSeg& seg = tr.segs[l];
+// image offset per unit C (the ray's, or its cell's with ConeCentre::Cell); seg: tr.segs[l].
+std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, const LayerSeg& seg, float cx,
+                                 float cy, glm::vec2 w, bool shade, glm::vec3 eye,
+                                 TileCounters& cnt) {
     // Where the ray is where its image offset is c (at stored depth t, c = C(t)): off the image,
     // clamped to its border (as a clamped ray reads the border texels, OffscreenPolicy::Clamp)
     // or none (Discard).

@@ -253,7 +253,9 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
 // per tile layer (setLayer), the pixel's once per pixel and layer (setPixel).
 struct PixelLayer {
     uint32_t l = 0;
-    const LayerSeg* seg = nullptr;
+    // A copy of the layer's segment: a local the ray's stores cannot change, so its values stay
+    // in registers over the layer's rays.
+    LayerSeg seg;
     const float* depth = nullptr; // the layer's stored depths
     bool shade = false;           // hits are shaded per ray (§5)
     // Sample k's path walked in advance through the whole segment: paths[k * path_stride];
@@ -268,7 +270,7 @@ struct PixelLayer {
 
     void setLayer(const Tracer& tr, uint32_t layer) {
         l = layer;
-        seg = &tr.segs[l];
+        seg = tr.segs[l];
         depth = tr.scratch->depth[l].data();
         shade = tr.settings->view_dependent || tr.settings->env_map;
         paths = tr.paths.empty() ? nullptr : tr.paths.data() + l;
@@ -279,7 +281,7 @@ struct PixelLayer {
         cx = float(x) + 0.5f, cy = float(y) + 0.5f;
         hittable = (pls.hittable >> l) & 1;
         cones = (pls.cones >> l) & 1;
-        const auto& box = seg->paths_box;
+        const auto& box = seg.paths_box;
         paths_inside = paths && box.x0 <= box.x1 && int64_t(x) + box.x0 >= 0 &&
                        int64_t(y) + box.y0 >= 0 && int64_t(x) + box.x1 < int64_t(tr.width) &&
                        int64_t(y) + box.y1 < int64_t(tr.height);
@@ -319,7 +321,7 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
         return false;
     };
     ++cnt.layer_steps;
-    const LayerSeg& seg = *pl.seg;
+    const LayerSeg& seg = pl.seg;
     const float s0 = std::max(seg.t0, ray.t_resume);
     if constexpr (Rec::kOn)
         rec.beginStep(k, l, s0, cnt);
@@ -366,7 +368,7 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
     // composited in depth order with the transparent plane.
     std::optional<MissCone> miss;
     if (!h.hit && pl.cones && s0 == seg.t0)
-        miss = missCone(tr, l, cx, cy, wc, shade, shade_from, cnt);
+        miss = missCone(tr, l, seg, cx, cy, wc, shade, shade_from, cnt);
     auto addMiss = [&] {
         if (blend(miss->v1, miss->c1))
             ray.t_end = miss->t;
@@ -519,7 +521,11 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
 template <class Rec>
 void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
                const uint32_t* tile_layers, uint32_t tile_layer_count, RayState* rays,
-               PixelLayers* pixel_layers, float* rgba, TileCounters& cnt, Rec& rec) {
+               PixelLayers* pixel_layers, float* rgba, TileCounters& counters, Rec& rec) {
+    // Counted in a local: the compiler then knows that the counts' stores change none of the
+    // Tracer's, segments' or buffers' values, and need not load those again after each count
+    // (traceTileAvx2 on demo 400x300, N = 32: 2 % fewer instructions).
+    TileCounters cnt = counters;
     const uint32_t n = tr.samples->size();
     const uint32_t tw = x1 - x0;
     std::array<LayerCulls, raster::kMaxLayers> culls;
@@ -556,7 +562,7 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                     continue;
                 pxl.setPixel(tr, x, y, pixel_layers[p]);
                 RayState* pr = rays + p * n;
-                const bool plain = !pxl.shade && !pxl.seg->transparent;
+                const bool plain = !pxl.shade && !pxl.seg.transparent;
                 uint32_t live = 0;
                 for (uint32_t k = 0; k < n; ++k)
                     if (pr[k].transmit > 0.0f) {
@@ -578,6 +584,7 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
             if (!pixel_layers[p].resolved)
                 endPixel(tr, x, y, rays + p * n, rec.pixelOut(rgba, tr, x, y, true), cnt, rec);
         }
+    counters = cnt;
 }
 
 // traceTile compiled twice, for the baseline x86-64 and for AVX2 (the raster kernels' written-
