@@ -562,18 +562,21 @@ void traceTile(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t
                     continue;
                 pxl.setPixel(tr, x, y, pixel_layers[p]);
                 RayState* pr = rays + p * n;
-                const bool plain = !pxl.shade && !pxl.seg.transparent;
-                uint32_t live = 0;
-                for (uint32_t k = 0; k < n; ++k)
-                    if (pr[k].transmit > 0.0f) {
-                        if (plain)
-                            traceLayer<true>(tr, pxl, k, pr[k], cnt, rec);
-                        else
-                            traceLayer<false>(tr, pxl, k, pr[k], cnt, rec);
-                        if constexpr (Rec::kOn)
-                            rec.endStep(pr[k], cnt);
-                        live += pr[k].transmit > 0.0f ? 1 : 0;
-                    }
+                // The live rays through the layer, one loop per traceLayer variant.
+                const auto traceRays = [&]<bool kPlain>() {
+                    uint32_t live = 0;
+                    for (uint32_t k = 0; k < n; ++k)
+                        if (pr[k].transmit > 0.0f) {
+                            traceLayer<kPlain>(tr, pxl, k, pr[k], cnt, rec);
+                            if constexpr (Rec::kOn)
+                                rec.endStep(pr[k], cnt);
+                            live += pr[k].transmit > 0.0f ? 1 : 0;
+                        }
+                    return live;
+                };
+                const uint32_t live = !pxl.shade && !pxl.seg.transparent
+                                          ? traceRays.template operator()<true>()
+                                          : traceRays.template operator()<false>();
                 if (live == 0)
                     pixel_layers[p].active = 0; // every ray has ended: no layer behind is met
             }
