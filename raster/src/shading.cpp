@@ -61,10 +61,10 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
         const glm::vec2 uv = transformUv(ref, in.uv[l]);
         lanes.u[l] = uv.x, lanes.v[l] = uv.y;
     }
-    // One by one when at most kFewLanes lanes are asked for (a kernel call costs about as much as
-    // three one-fragment lookups; callgrind on ToyCar) or the image is beyond the kernel's
-    // integers.
-    constexpr int kFewLanes = 2;
+    // One by one when at most kFewLanes lanes are asked for (with gathers, an AVX2 kernel call
+    // costs about as much as 1.3 one-fragment lookups; callgrind on ToyCar, docs/raster.md 8.2)
+    // or the image is beyond the kernel's integers.
+    constexpr int kFewLanes = 1;
     if (__builtin_popcount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
         for (int l = 0; l < kTextureLanes; ++l) {
             if (!(lane_mask & (1u << l)))

@@ -1,7 +1,8 @@
 // Body of the texture kernel (texture_kernel.h); included by texture_kernel.cpp and
 // texture_kernel_avx2.cpp. Lane loops over fixed-size arrays doing, per lane, the operations of
 // texture.cpp's sampleLevel in the same order, so the results are its bits; branches only on
-// what the lanes share. No calls to inline library templates (see quad_kernel.inl).
+// what the lanes share. No calls to inline library templates (see quad_kernel.inl). The table
+// loads (texel words, the sRGB table) go through gatherLanes: AVX2 gathers in the AVX2 build.
 #ifndef FOCAL_TEXTURE_KERNEL_NAME
 #error "define FOCAL_TEXTURE_KERNEL_NAME before including texture_kernel.inl"
 #endif
@@ -11,10 +12,15 @@ namespace {
 constexpr int kLanes = kTextureLanes;
 
 // texture.cpp's texelCoord: u * size - 1/2 in double (exact: a float times an integer below
-// 2^22), 0 for non-finite u, clamped to +-2^30 so the integer part fits int32.
+// 2^22), 0 for non-finite u, clamped to +-2^30 so the integer part fits int32. Written as three
+// selects on doubles, one after the other (a non-finite u gives an infinite or NaN x that the
+// last select replaces), which vectorize as compare and blend pairs.
 inline double texelCoordLane(float u, double size) {
-    const double x = __builtin_fabsf(u) <= 3.40282347e38f ? double(u) * size - 0.5 : 0.0;
-    return x < -1073741824.0 ? -1073741824.0 : (1073741824.0 < x ? 1073741824.0 : x);
+    const double d = double(u);
+    double x = d * size - 0.5;
+    x = x < -1073741824.0 ? -1073741824.0 : x;
+    x = 1073741824.0 < x ? 1073741824.0 : x;
+    return __builtin_fabs(d) <= double(__FLT_MAX__) ? x : 0.0;
 }
 
 // texture.cpp's wrapIndex of i and of i + 1, for |i| <= 2^30 and 0 < n <= kTextureKernelMaxSide.
@@ -43,20 +49,49 @@ inline void wrapLanes(const int32_t* i, int32_t n, Wrap mode, int32_t* w0, int32
         }
 }
 
-// Texel (x, y) of every lane as linear RGBA (texture.cpp's fetch). Indices are int32 so the
-// vectorizer can use gathers.
+// out[l] = table[index[l]] for every lane, each index valid: one 8-lane gather in the AVX2 build
+// (GCC 12 does not vectorize these loads by itself), a lane loop in the scalar reference. The
+// AVX2 file asks for the gathers with FOCAL_TEXTURE_KERNEL_GATHERS (not __AVX2__, so that the
+// reference stays scalar under -march flags that enable AVX2).
+inline void gatherLanes(const TexelWord* table, const int32_t* index, uint32_t* out) {
+#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
+    const __m256i i = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
+                        _mm256_i32gather_epi32(reinterpret_cast<const int*>(table), i, 4));
+#else
+    for (int l = 0; l < kLanes; ++l)
+        out[l] = table[index[l]];
+#endif
+}
+
+inline void gatherLanes(const float* table, const int32_t* index, float* out) {
+#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
+    const __m256i i = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
+    _mm256_storeu_ps(out, _mm256_i32gather_ps(table, i, 4));
+#else
+    for (int l = 0; l < kLanes; ++l)
+        out[l] = table[index[l]];
+#endif
+}
+
+// Texel (x, y) of every lane as linear RGBA (texture.cpp's fetch). Indices are int32, below
+// kTextureKernelMaxTexels: the gathers' indices.
 inline void fetchLanes(const TextureLevel& level, const float* lut, const int32_t* x,
                        const int32_t* y, float (*rgba)[kLanes]) {
-    alignas(32) uint32_t t[kLanes];
+    alignas(32) int32_t index[kLanes];
     for (int l = 0; l < kLanes; ++l)
-        t[l] = level.texels[y[l] * level.width + x[l]];
+        index[l] = y[l] * level.width + x[l];
+    alignas(32) uint32_t t[kLanes];
+    gatherLanes(level.texels, index, t);
     if (lut) {
-        for (int l = 0; l < kLanes; ++l) {
-            rgba[0][l] = lut[int32_t(t[l] & 0xffu)];
-            rgba[1][l] = lut[int32_t((t[l] >> 8) & 0xffu)];
-            rgba[2][l] = lut[int32_t((t[l] >> 16) & 0xffu)];
+        alignas(32) int32_t byte[3][kLanes];
+        for (int c = 0; c < 3; ++c)
+            for (int l = 0; l < kLanes; ++l)
+                byte[c][l] = int32_t((t[l] >> (8 * c)) & 0xffu);
+        for (int c = 0; c < 3; ++c)
+            gatherLanes(lut, byte[c], rgba[c]);
+        for (int l = 0; l < kLanes; ++l)
             rgba[3][l] = float(int32_t(t[l] >> 24)) * (1.0f / 255.0f);
-        }
         return;
     }
     for (int c = 0; c < 4; ++c)

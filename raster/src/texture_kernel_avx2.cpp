@@ -6,11 +6,15 @@
 #error "texture_kernel_avx2.cpp must be compiled with -mavx2"
 #endif
 
+#include <immintrin.h>
+
 namespace raster {
 
 namespace {
 #define FOCAL_TEXTURE_KERNEL_NAME textureKernelAvx2Impl
+#define FOCAL_TEXTURE_KERNEL_GATHERS 1
 #include "texture_kernel.inl"
+#undef FOCAL_TEXTURE_KERNEL_GATHERS
 #undef FOCAL_TEXTURE_KERNEL_NAME
 } // namespace
 
