@@ -80,8 +80,11 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
 // lie in the 2x2 blocks the coarser level's four taps average (u0 = 2 u1 + 1/2), so the block
 // of the last level read (`last`, lastConeLevel) decides it: `empty_blocks` says which blocks
 // have four zero coverages (MultiviewScratch::owned_empty_blocks). False when unsure.
-inline bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float px, float py,
-                       uint32_t l0, uint32_t last) {
+// `inside`: the caller knows that the taps of both levels lie inside them (missCone's
+// LayerSeg::first_cone_px margin), so only the last level's block is looked up.
+template <bool kInside = false>
+bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float px, float py, uint32_t l0,
+                uint32_t last) {
     // The 2x2 block at level L under (px, py), false when the taps there are not all inside.
     int64_t block = 0;
     const auto inside = [&](uint32_t level) {
@@ -89,9 +92,11 @@ inline bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float p
         const float scale = kMipScale[level];
         const float fu = std::floor(px * scale - 0.5f), fv = std::floor(py * scale - 0.5f);
         block = int64_t(fv) * m.width + int64_t(fu);
-        return fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v;
+        return kInside || (fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v);
     };
-    if (!inside(l0) || (last != l0 && !inside(last)))
+    if (kInside)
+        inside(last);
+    else if (!inside(l0) || (last != l0 && !inside(last)))
         return false;
     return empty_blocks[block] != 0;
 }
@@ -129,9 +134,11 @@ struct MissCone {
 // as for a clamped hit) and not at all under Discard; the culling windows, clamped to the
 // image, then still hold every texel read. None when the cone sees nothing. w: the cone centre's
 // image offset per unit C (the ray's, or its cell's with ConeCentre::Cell); seg: tr.segs[l].
+// first_inside: the pixel centre (cx, cy) is at least seg.first_cone_px inside the image, so the
+// first lookup's position is inside the image and its taps inside their levels.
 std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, const LayerSeg& seg, float cx,
-                                 float cy, glm::vec2 w, bool shade, glm::vec3 eye,
-                                 TileCounters& cnt) {
+                                 float cy, glm::vec2 w, bool first_inside, bool shade,
+                                 glm::vec3 eye, TileCounters& cnt) {
     // Where the ray is where its image offset is c (at stored depth t, c = C(t)): off the image,
     // clamped to its border (as a clamped ray reads the border texels, OffscreenPolicy::Clamp)
     // or none (Discard).
@@ -146,12 +153,17 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, const LayerSeg& s
         return true;
     };
     float px = 0.0f, py = 0.0f;
-    if (!at(seg.coc_cone, px, py))
-        return std::nullopt;
     const MipChain& owned = tr.owned_mips[l];
     // Most rays pass where the layer owns nothing near them: no coverage, no lookup.
-    if (mipEmptyAt(owned, seg.cone_empty_blocks, px, py, seg.cone_level.l0, seg.cone_last_level))
+    if (first_inside) {
+        px = cx + seg.coc_cone * w.x, py = cy + seg.coc_cone * w.y; // as `at` inside the image
+        if (mipEmptyAt<true>(owned, seg.cone_empty_blocks, px, py, seg.cone_level.l0,
+                             seg.cone_last_level))
+            return std::nullopt;
+    } else if (!at(seg.coc_cone, px, py) || mipEmptyAt(owned, seg.cone_empty_blocks, px, py,
+                                                       seg.cone_level.l0, seg.cone_last_level)) {
         return std::nullopt;
+    }
     const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(owned, px, py, seg.cone_level);
     if (!(d[1] > 0.0f))
         return std::nullopt;

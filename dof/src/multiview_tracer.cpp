@@ -266,7 +266,10 @@ struct PixelLayer {
     float cx = 0.0f, cy = 0.0f; // the pixel's centre
     bool hittable = false;      // PixelLayers::hittable
     bool cones = false;         // PixelLayers::cones
-    bool paths_inside = false;  // every path of the layer lies in the image around the pixel
+    // The pixel centre lies first_cone_px inside the image: the missed cones' first lookups are
+    // inside the image and their taps inside their mip levels (missCone).
+    bool first_cones_inside = false;
+    bool paths_inside = false; // every path of the layer lies in the image around the pixel
 
     void setLayer(const Tracer& tr, uint32_t layer) {
         l = layer;
@@ -281,6 +284,11 @@ struct PixelLayer {
         cx = float(x) + 0.5f, cy = float(y) + 0.5f;
         hittable = (pls.hittable >> l) & 1;
         cones = (pls.cones >> l) & 1;
+        // A first lookup is within r_max |C(t_cone)| (+ rounding) of the centre, and its taps
+        // inside level L when 2^(L-1) <= px < width - 2^(L-1): first_cone_px holds both.
+        const float r = seg.first_cone_px;
+        first_cones_inside = cx - r >= 0.0f && cy - r >= 0.0f && cx + r <= float(tr.width) &&
+                             cy + r <= float(tr.height);
         const auto& box = seg.paths_box;
         paths_inside = paths && box.x0 <= box.x1 && int64_t(x) + box.x0 >= 0 &&
                        int64_t(y) + box.y0 >= 0 && int64_t(x) + box.x1 < int64_t(tr.width) &&
@@ -368,7 +376,7 @@ void traceLayer(const Tracer& tr, const PixelLayer& pl, uint32_t k, RayState& ra
     // composited in depth order with the transparent plane.
     std::optional<MissCone> miss;
     if (!h.hit && pl.cones && s0 == seg.t0)
-        miss = missCone(tr, l, seg, cx, cy, wc, shade, shade_from, cnt);
+        miss = missCone(tr, l, seg, cx, cy, wc, pl.first_cones_inside, shade, shade_from, cnt);
     auto addMiss = [&] {
         if (blend(miss->v1, miss->c1))
             ray.t_end = miss->t;
