@@ -80,7 +80,7 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
 // lie in the 2x2 blocks the coarser level's four taps average (u0 = 2 u1 + 1/2), so the block
 // of the last level read (`last`, lastConeLevel) decides it: `empty_blocks` says which blocks
 // have four zero coverages (MultiviewScratch::owned_empty_blocks). False when unsure.
-// `inside`: the caller knows that the taps of both levels lie inside them (missCone's
+// kInside: the caller knows that the taps of both levels lie inside them (missCone's
 // LayerSeg::first_cone_px margin), so only the last level's block is looked up.
 template <bool kInside = false>
 bool mipEmptyAt(const MipChain& mip, const uint8_t* empty_blocks, float px, float py, uint32_t l0,
