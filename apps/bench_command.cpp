@@ -239,17 +239,37 @@ void runMainStudy(const SceneRuns& c, BenchResults& results, Progress& progress)
     markPareto(results.rows, results.rows_of_scene[c.scene.spec]);
 }
 
-// Thread scaling: each method's scaling setting at 1, 2, 4... threads.
+// Rounds of the scaling study (runScalingStudy).
+constexpr size_t kScalingRounds = 3;
+
+// Thread scaling: each method's scaling setting at 1, 2, 4... threads. The thread counts take
+// turns over kScalingRounds rounds, and each count keeps its round of median time: a slow spell
+// of a shared machine then falls on every count alike instead of on one row of the ratio t1 / tn.
 Status runScalingStudy(const SceneRuns& c, BenchResults& results, Progress& progress) {
-    for (const std::string& method : c.args.methods)
-        for (uint32_t t : scalingThreadCounts()) {
-            Result<Json> row = runCase(
-                c, method, studySetting(method, c.args.quick, &Setting::scaling), t, "scaling");
-            if (!row.ok())
-                return row.status();
-            results.rows.push_back(std::move(*row));
-            progress.step(c.scene.name + " " + progressText(results.rows.back()));
+    const std::vector<uint32_t> counts = scalingThreadCounts();
+    for (const std::string& method : c.args.methods) {
+        const Setting setting = studySetting(method, c.args.quick, &Setting::scaling);
+        std::vector<std::vector<Json>> rounds(counts.size());
+        for (size_t round = 0; round < kScalingRounds; ++round)
+            for (size_t i = 0; i < counts.size(); ++i) {
+                Result<Json> row = runCase(c, method, setting, counts[i], "scaling");
+                if (!row.ok())
+                    return row.status();
+                progress.step(c.scene.name + " " + progressText(*row));
+                rounds[i].push_back(std::move(*row));
+            }
+        for (std::vector<Json>& rows : rounds) {
+            std::vector<double> ms;
+            for (const Json& row : rows)
+                ms.push_back(row["ms_median"].get<double>());
+            std::sort(rows.begin(), rows.end(), [](const Json& a, const Json& b) {
+                return a["ms_median"].get<double>() < b["ms_median"].get<double>();
+            });
+            Json kept = std::move(rows[rows.size() / 2]);
+            kept["scaling_rounds_ms"] = ms; // every round's median, in run order
+            results.rows.push_back(std::move(kept));
         }
+    }
     return {};
 }
 
@@ -408,7 +428,7 @@ int runBench(BenchArgs args) {
     for (const std::string& m : args.methods)
         total += scenes.size() * settingsFor(m, args.quick).size();
     if (!args.no_scaling)
-        total += scalingThreadCounts().size() * args.methods.size();
+        total += kScalingRounds * scalingThreadCounts().size() * args.methods.size();
     Progress progress(total, bench_start);
 
     BenchResults results;

@@ -99,18 +99,17 @@ namespace {
 std::string csvCell(const Json& v) {
     if (v.is_null())
         return "";
-    if (v.is_string()) {
-        std::string s = v.get<std::string>();
-        if (s.find_first_of(",\"\n") == std::string::npos)
-            return s;
-        std::string q = "\"";
-        for (char c : s)
-            q += c == '"' ? std::string("\"\"") : std::string(1, c);
-        return q + "\"";
-    }
     if (v.is_boolean())
         return v.get<bool>() ? "1" : "0";
-    return v.dump();
+    // Strings as they are, anything else (numbers, arrays) as JSON; quoted when it holds a
+    // comma, a quote or a line break.
+    const std::string s = v.is_string() ? v.get<std::string>() : v.dump();
+    if (s.find_first_of(",\"\n") == std::string::npos)
+        return s;
+    std::string q = "\"";
+    for (char c : s)
+        q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
 }
 
 } // namespace

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -109,6 +110,11 @@ TEST_F(BenchQuick, WritesParsableResults) {
         if (row["study"] == "scaling") {
             ++scaling_rows;
             EXPECT_GT(row["parallel_efficiency"].get<double>(), 0.0);
+            // The thread counts take turns over three rounds; the row is the median round.
+            std::vector<double> rounds = row["scaling_rounds_ms"].get<std::vector<double>>();
+            ASSERT_EQ(rounds.size(), 3u);
+            std::sort(rounds.begin(), rounds.end());
+            EXPECT_EQ(row["ms_median"].get<double>(), rounds[1]);
             continue;
         }
         ++main_rows;
