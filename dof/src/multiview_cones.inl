@@ -141,10 +141,10 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, const LayerSeg& s
                                  glm::vec3 eye, TileCounters& cnt) {
     // Where the ray is where its image offset is c (at stored depth t, c = C(t)): off the image,
     // clamped to its border (as a clamped ray reads the border texels, OffscreenPolicy::Clamp)
-    // or none (Discard).
-    auto at = [&](float c, float& px, float& py) {
+    // or none (Discard). `inside`: known to lie in the image.
+    auto at = [&](float c, float& px, float& py, bool inside = false) {
         px = cx + c * w.x, py = cy + c * w.y;
-        if (tr.inImage(px, py))
+        if (inside || tr.inImage(px, py))
             return true;
         if (tr.settings->offscreen != OffscreenPolicy::Clamp)
             return false;
@@ -154,16 +154,13 @@ std::optional<MissCone> missCone(const Tracer& tr, uint32_t l, const LayerSeg& s
     };
     float px = 0.0f, py = 0.0f;
     const MipChain& owned = tr.owned_mips[l];
-    // Most rays pass where the layer owns nothing near them: no coverage, no lookup.
-    if (first_inside) {
-        px = cx + seg.coc_cone * w.x, py = cy + seg.coc_cone * w.y; // as `at` inside the image
-        if (mipEmptyAt<true>(owned, seg.cone_empty_blocks, px, py, seg.cone_level.l0,
-                             seg.cone_last_level))
-            return std::nullopt;
-    } else if (!at(seg.coc_cone, px, py) || mipEmptyAt(owned, seg.cone_empty_blocks, px, py,
-                                                       seg.cone_level.l0, seg.cone_last_level)) {
+    if (!at(seg.coc_cone, px, py, first_inside))
         return std::nullopt;
-    }
+    // Most rays pass where the layer owns nothing near them: no coverage, no lookup.
+    const uint32_t l0 = seg.cone_level.l0, last = seg.cone_last_level;
+    if (first_inside ? mipEmptyAt<true>(owned, seg.cone_empty_blocks, px, py, l0, last)
+                     : mipEmptyAt<false>(owned, seg.cone_empty_blocks, px, py, l0, last))
+        return std::nullopt;
     const std::array<float, 2> d = sampleMip<2, kOwnedChannels>(owned, px, py, seg.cone_level);
     if (!(d[1] > 0.0f))
         return std::nullopt;

@@ -49,25 +49,17 @@ inline void wrapLanes(const int32_t* i, int32_t n, Wrap mode, int32_t* w0, int32
         }
 }
 
-// out[l] = table[index[l]] for every lane, each index valid: one 8-lane gather in the AVX2 build
-// (GCC 12 does not vectorize these loads by itself), a lane loop in the scalar reference. The
-// AVX2 file asks for the gathers with FOCAL_TEXTURE_KERNEL_GATHERS (not __AVX2__, so that the
-// reference stays scalar under -march flags that enable AVX2).
-inline void gatherLanes(const TexelWord* table, const int32_t* index, uint32_t* out) {
+// out[l] = table[index[l]] for every lane, each index valid, for any 4-byte T (texel words,
+// the sRGB table's floats): one 8-lane gather of 32-bit words in the AVX2 build (GCC 12 does not
+// vectorize these loads by itself), a lane loop in the scalar reference. The AVX2 file asks for
+// the gathers with FOCAL_TEXTURE_KERNEL_GATHERS (not __AVX2__, so that the reference stays
+// scalar under -march flags that enable AVX2).
+template <class T> void gatherLanes(const T* table, const int32_t* index, T* out) {
+    static_assert(sizeof(T) == 4);
 #ifdef FOCAL_TEXTURE_KERNEL_GATHERS
     const __m256i i = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
                         _mm256_i32gather_epi32(reinterpret_cast<const int*>(table), i, 4));
-#else
-    for (int l = 0; l < kLanes; ++l)
-        out[l] = table[index[l]];
-#endif
-}
-
-inline void gatherLanes(const float* table, const int32_t* index, float* out) {
-#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
-    const __m256i i = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
-    _mm256_storeu_ps(out, _mm256_i32gather_ps(table, i, 4));
 #else
     for (int l = 0; l < kLanes; ++l)
         out[l] = table[index[l]];
