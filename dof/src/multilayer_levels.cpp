@@ -101,7 +101,10 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
     dropped.assign(out.height, 0);
     skipped.assign(out.height, 0);
     pool.parallelFor(out.height, [&](uint32_t j, uint32_t) {
-        std::vector<LayerFragment>& row = out.rows[j];
+        // The row is filled in a local vector and moved back (no allocation): neighbouring
+        // rows' vectors share cache lines, and a store to this one's end per fragment made the
+        // two workers' rows fight over them.
+        std::vector<LayerFragment> row = std::move(out.rows[j]);
         row.clear();
         uint32_t* starts = out.starts.data() + size_t(j) * (out.width + 1);
         auto keep = [&](float d) {
@@ -122,6 +125,7 @@ void mergeCells(const LevelPlan& plan, const LevelBorders& borders, uint32_t bor
             row_longest = std::max(row_longest, uint32_t(row.size()) - starts[i]);
         }
         starts[out.width] = uint32_t(row.size());
+        out.rows[j] = std::move(row);
         longest[j] = row_longest;
         dropped[j] = row_dropped;
         skipped[j] = row_skipped;
@@ -321,7 +325,7 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
     std::vector<uint32_t>& longest = out.scratch.longest;
     longest.assign(lists.height, 0);
     pool.parallelFor(lists.height, [&](uint32_t y, uint32_t) {
-        std::vector<LayerFragment>& row = out.rows[y];
+        std::vector<LayerFragment> row = std::move(out.rows[y]); // filled locally (see mergeCells)
         row.clear();
         uint32_t* starts = out.starts.data() + size_t(y) * (lists.width + 1);
         uint32_t row_longest = 0; // stored once (see mergeCells)
@@ -339,6 +343,7 @@ void makeBaseLevel(const raster::FragmentLists& lists, const raster::View& view,
             row_longest = std::max(row_longest, uint32_t(row.size()) - starts[x]);
         }
         starts[lists.width] = uint32_t(row.size());
+        out.rows[y] = std::move(row);
         longest[y] = row_longest;
     });
     std::vector<uint64_t>& none = out.scratch.dropped;

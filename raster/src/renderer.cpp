@@ -512,6 +512,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         std::vector<FragmentNode>& list = st.sort_scratch[worker];
         std::vector<FragmentNode>& kept = st.list_kept[tile];
         kept.clear();
+        // Counted in locals and stored once: neighbouring tiles' entries share cache lines, and
+        // a store per pixel made the two workers' tiles fight over them.
+        uint32_t tile_longest = 0;
+        uint64_t tile_hidden = 0;
         for (uint32_t y = r.y0; y < r.y1; ++y)
             for (uint32_t x = r.x0; x < r.x1; ++x) {
                 const size_t p = size_t(y) * view.width + x;
@@ -519,7 +523,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                 for (uint32_t i = st.list_head[p]; i != kNoNode; i = nodes[i].next)
                     list.push_back(nodes[i]);
                 const uint32_t n = uint32_t(list.size());
-                longest[tile] = std::max(longest[tile], n);
+                tile_longest = std::max(tile_longest, n);
                 out.list_length[p] = n;
                 // Total order: depth, then primitive id (never arrival order).
                 std::sort(list.begin(), list.end(),
@@ -536,7 +540,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                     if (hidden_scale > 0.0f) {
                         const float d = distanceFromDepth(view, f.z);
                         if (opaque >= 0.0f && d <= opaque * hidden_scale) {
-                            ++hidden[tile];
+                            ++tile_hidden;
                             continue;
                         }
                         if (f.color.a >= 1.0f)
@@ -547,6 +551,8 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                 }
                 out.offsets[p + 1] = count;
             }
+        longest[tile] = tile_longest;
+        hidden[tile] = tile_hidden;
     });
     for (size_t p = 0; p < pixels; ++p)
         out.offsets[p + 1] += out.offsets[p];
