@@ -2,9 +2,9 @@
 // (transform/clip/cull), binning, tile raster coverage (unlit) and coverage + shading (material),
 // layer decomposition (Lee et al. 2009 §4.2 layered rendering), fragment-list building (Selgrad
 // et al. 2015 §4), the gather filter (Zhou et al. 2007), multiview ray traversal and multilayer
-// list filtering (whole methods; their per-stage times are reported as counters), and the error
-// metrics. Everything runs inline (TaskPool(0)) on one thread at 400x300 from each scene's
-// default camera, so numbers are per-core costs. Run:
+// list filtering (whole methods; their per-stage times are reported as counters), the error
+// metrics, and the task pool's cost per parallelFor. The stages run inline (TaskPool(0)) on one
+// thread at 400x300 from each scene's default camera, so their numbers are per-core costs. Run:
 //   build/bench/focal_microbench --benchmark_filter=Binning
 #include "apps/scene_source.h"
 #include "raster/src/binning.h"
@@ -24,6 +24,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <atomic>
+#include <chrono>
 #include <map>
 #include <memory>
 #include <string>
@@ -226,6 +228,28 @@ void BM_Metrics(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * int64_t(kWidth) * kHeight);
 }
 BENCHMARK(BM_Metrics)->Unit(benchmark::kMillisecond);
+
+// One TaskPool::parallelFor of two trivial tasks on a two-worker pool (the caller and one
+// thread): the fixed cost a stage pays per call, which a frame pays about 40 times (multilayer).
+// Arg 0: calls back to back; arg N: N microseconds of the caller's own work before each call,
+// long enough for the worker to have gone to sleep.
+void BM_TaskPoolRoundTrip(benchmark::State& state) {
+    raster::TaskPool pool(2);
+    const auto gap = std::chrono::microseconds(state.range(0));
+    std::atomic<uint32_t> sum{0};
+    for (auto _ : state) {
+        if (gap.count() > 0) {
+            state.PauseTiming();
+            const auto until = std::chrono::steady_clock::now() + gap;
+            while (std::chrono::steady_clock::now() < until) {
+            }
+            state.ResumeTiming();
+        }
+        pool.parallelFor(2, [&](uint32_t i, uint32_t) { sum.fetch_add(i); });
+    }
+    benchmark::DoNotOptimize(sum.load());
+}
+BENCHMARK(BM_TaskPoolRoundTrip)->Arg(0)->Arg(1000)->Unit(benchmark::kMicrosecond);
 
 } // namespace
 

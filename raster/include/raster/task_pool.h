@@ -2,9 +2,16 @@
 // globals). parallelFor hands out indices from one atomic counter; which worker runs which index
 // is not deterministic, so callers write each result to a slot owned by its index.
 // threads == 0 runs everything inline on the calling thread.
+//
+// A frame makes tens of parallelFor calls with a little serial work between them. Waking a
+// sleeping thread through the kernel costs tens of microseconds (more in a virtual machine), and
+// the caller would run alone meanwhile; so a worker that finishes spins for a while before it
+// sleeps, and so does the caller waiting for the last worker (not when there are more threads
+// than cores). The condition variables are notified only when some thread is asleep on them.
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
@@ -60,17 +67,22 @@ private:
 
     uint32_t thread_count_ = 0;
     uint32_t worker_count_ = 1;
+    std::chrono::microseconds spin_{0}; // how long an idle thread spins before it sleeps
     std::vector<std::thread> threads_;
     std::mutex mutex_;
     std::condition_variable wake_;
     std::condition_variable done_;
+    // The job, written by parallelFor before it publishes a new generation (release) and read
+    // by the workers after they see it (acquire).
     const TaskFn* job_ = nullptr;
     uint32_t job_count_ = 0;
-    uint64_t generation_ = 0;
-    uint32_t busy_ = 0;
-    bool stop_ = false;
+    std::atomic<uint64_t> generation_{0}; // incremented (under mutex_) per job and at shutdown
+    std::atomic<uint32_t> busy_{0};       // threads still draining the current job
+    std::atomic<bool> stop_{false};
     std::atomic<uint32_t> next_{0};
-    std::exception_ptr failure_; // the first exception fn threw (guarded by mutex_)
+    uint32_t sleeping_ = 0;       // threads waiting on wake_ (guarded by mutex_)
+    bool caller_waiting_ = false; // the caller waits on done_ (guarded by mutex_)
+    std::exception_ptr failure_;  // the first exception fn threw (guarded by mutex_)
 };
 
 } // namespace raster
