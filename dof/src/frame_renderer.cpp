@@ -4,6 +4,7 @@
 #include <dof/frame_renderer.h>
 #include <raster/fragment_lists.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -66,27 +67,37 @@ void addStats(raster::FrameStats& sum, const raster::FrameStats& one) {
     sum.target_bytes = std::max(sum.target_bytes, one.target_bytes);
 }
 
+// Rows per task of the copies into the caller's image: a copy by one thread would be serial
+// time in every frame.
+constexpr uint32_t kCopyRows = 16;
+
 // Copies width x height RGBA pixels (rows of width*4 floats) into the caller's rows.
-void copyRows(const float* src, uint32_t width, uint32_t height, const FrameImage& image) {
+void copyRows(raster::TaskPool& pool, const float* src, uint32_t width, uint32_t height,
+              const FrameImage& image) {
     const size_t row = size_t(width) * 4;
-    for (uint32_t y = 0; y < height; ++y)
-        std::memcpy(image.rgba + size_t(y) * image.stride, src + size_t(y) * row,
-                    row * sizeof(float));
+    pool.parallelFor((height + kCopyRows - 1) / kCopyRows, [&](uint32_t task, uint32_t) {
+        for (uint32_t y = task * kCopyRows; y < std::min(height, (task + 1) * kCopyRows); ++y)
+            std::memcpy(image.rgba + size_t(y) * image.stride, src + size_t(y) * row,
+                        row * sizeof(float));
+    });
 }
 
 // The distance along the view axis of each stored depth D (+inf where D >= kFarDepth when
 // `empty_is_infinite`), into the caller's depth rows.
-void writeDepth(const raster::View& view, const raster::DepthBuffer& depth, bool empty_is_infinite,
-                const FrameImage& image) {
-    for (uint32_t y = 0; y < view.height; ++y) {
-        float* row = image.depth + size_t(y) * image.depth_stride;
-        for (uint32_t x = 0; x < view.width; ++x) {
-            const float d = depth.load(size_t(y) * view.width + x);
-            row[x] = empty_is_infinite && !(d < raster::kFarDepth)
-                         ? INFINITY
-                         : raster::distanceFromDepth(view, d);
+void writeDepth(raster::TaskPool& pool, const raster::View& view, const raster::DepthBuffer& depth,
+                bool empty_is_infinite, const FrameImage& image) {
+    const uint32_t height = view.height;
+    pool.parallelFor((height + kCopyRows - 1) / kCopyRows, [&](uint32_t task, uint32_t) {
+        for (uint32_t y = task * kCopyRows; y < std::min(height, (task + 1) * kCopyRows); ++y) {
+            float* row = image.depth + size_t(y) * image.depth_stride;
+            for (uint32_t x = 0; x < view.width; ++x) {
+                const float d = depth.load(size_t(y) * view.width + x);
+                row[x] = empty_is_infinite && !(d < raster::kFarDepth)
+                             ? INFINITY
+                             : raster::distanceFromDepth(view, d);
+            }
         }
-    }
+    });
 }
 
 } // namespace
@@ -289,9 +300,9 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
     if (std::holds_alternative<PinholeMethod>(method)) {
         if (Status s = sharedPinhole(); !s.ok())
             return s;
-        copyRows(pinhole_.color.data(), view.width, view.height, image);
+        copyRows(pool_, pinhole_.color.data(), view.width, view.height, image);
         if (image.depth)
-            writeDepth(view, pinhole_.depth, false, image);
+            writeDepth(pool_, view, pinhole_.depth, false, image);
         return observed({});
     }
 
@@ -325,9 +336,9 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                         observer ? observeAccum(*m) : m->progress, &accum_scratch_);
         if (!r.ok())
             return r.status();
-        copyRows(accum_.color.data(), view.width, view.height, image);
+        copyRows(pool_, accum_.color.data(), view.width, view.height, image);
         if (image.depth)
-            writeDepth(view, accum_.depth, false, image);
+            writeDepth(pool_, view, accum_.depth, false, image);
         report.stage_ms = {
             {"pinhole", r->ms_pinhole}, {"views", r->ms_views}, {"accumulate", r->ms_accumulate}};
         report.method_stats = *r;
@@ -354,9 +365,9 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
             gather(in, lens, pin, settings, rgba_, coc_out, &pool_, &gather_scratch_);
         if (!r.ok())
             return r.status();
-        copyRows(rgba_.data(), view.width, view.height, image);
+        copyRows(pool_, rgba_.data(), view.width, view.height, image);
         if (image.depth)
-            writeDepth(pin, pinhole_.depth, false, image);
+            writeDepth(pool_, pin, pinhole_.depth, false, image);
         report.stage_ms = {{"render", ms_render},
                            {"coc", r->ms_coc},
                            {"vertical", r->ms_vertical},
@@ -417,9 +428,9 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
             render_layers, pool_, rgba_, &pinhole_, &layers_, &multiview_scratch_);
         if (!r.ok())
             return r.status();
-        copyRows(rgba_.data(), view.width, view.height, image);
+        copyRows(pool_, rgba_.data(), view.width, view.height, image);
         if (image.depth)
-            writeDepth(view, pinhole_.depth, true, image);
+            writeDepth(pool_, view, pinhole_.depth, true, image);
         report.stage_ms = {{"pinhole", r->ms_pinhole},
                            {"decomposition", r->ms_decomposition},
                            {"nbuffer", r->ms_nbuffer},
@@ -459,7 +470,7 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                                       multilayer_image_, &st);
         !s.ok())
         return s;
-    copyRows(multilayer_image_.rgba.data(), view.width, view.height, image);
+    copyRows(pool_, multilayer_image_.rgba.data(), view.width, view.height, image);
     if (image.depth)
         for (uint32_t y = 0; y < view.height; ++y)
             std::memcpy(image.depth + size_t(y) * image.depth_stride,

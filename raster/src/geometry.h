@@ -88,7 +88,9 @@ struct SetupTri {
 
 constexpr uint32_t kClippedVertex = 0x80000000u;
 
-struct GeometryChunk {
+// Aligned to a cache line: neighbouring chunks are set up by different workers, and each
+// triangle appended updates the chunk's vector ends and counts.
+struct alignas(64) GeometryChunk {
     std::vector<SetupTri> tris;
     std::vector<ShadeVertex> clipped_vertices;
     uint64_t triangles_in = 0, triangles_culled = 0, triangles_clipped = 0;

@@ -250,13 +250,7 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
     out.width = view.width;
     out.height = view.height;
     const size_t pixels = size_t(view.width) * view.height;
-    out.color.resize(pixels * 4);
-    for (size_t i = 0; i < pixels; ++i) {
-        out.color[i * 4 + 0] = scene.background.r;
-        out.color[i * 4 + 1] = scene.background.g;
-        out.color[i * 4 + 2] = scene.background.b;
-        out.color[i * 4 + 3] = 1.0f;
-    }
+    out.color.resize(pixels * 4); // each tile fills its pixels with the background below
     out.depth.resize(options.depth_format, view.width, view.height);
     const bool transparency = st.ctx.blend_last; // the scene has BLEND materials
     out.transparent_depth.resize(options.depth_format, transparency ? view.width : 0,
@@ -268,6 +262,14 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
 
     const auto t0 = std::chrono::steady_clock::now();
     pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
+        // The background, filled by the tile's owner rather than by one thread before the tiles.
+        const TileRect r = tileRect(st.ctx.grid, tile);
+        for (uint32_t y = r.y0; y < r.y1; ++y) {
+            float* c = out.color.data() + (size_t(y) * view.width + r.x0) * 4;
+            for (uint32_t x = r.x0; x < r.x1; ++x, c += 4)
+                c[0] = scene.background.r, c[1] = scene.background.g, c[2] = scene.background.b,
+                c[3] = 1.0f;
+        }
         FrameSink sink{out, options.peel_depth};
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
     });
@@ -433,8 +435,12 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     // Collection: every fragment, in primitive order, into its tile's pool.
     auto t0 = std::chrono::steady_clock::now();
     pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
-        st.list_pools[tile].clear();
-        ListSink sink{st.list_head, st.list_pools[tile]};
+        // Each vector a task appends to is moved into a local and back (no allocation):
+        // neighbouring tiles' and workers' vector headers share cache lines, and updating one's
+        // end per fragment made the two workers fight over them.
+        std::vector<FragmentNode> nodes = std::move(st.list_pools[tile]);
+        nodes.clear();
+        ListSink sink{st.list_head, nodes};
         if (early_k > 0) {
             const TileRect r = tileRect(st.ctx.grid, tile);
             std::vector<float>& nearest = st.list_nearest[worker];
@@ -448,6 +454,7 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
             sink.tile_x0 = r.x0, sink.tile_y0 = r.y0, sink.tile_size = st.ctx.grid.tile_size;
         }
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
+        st.list_pools[tile] = std::move(nodes);
     });
     const double ms_raster = msSince(t0);
     uint64_t collected = 0;
@@ -509,11 +516,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
         const TileRect r = tileRect(st.ctx.grid, tile);
         const std::vector<FragmentNode>& nodes = st.list_pools[tile];
-        std::vector<FragmentNode>& list = st.sort_scratch[worker];
-        std::vector<FragmentNode>& kept = st.list_kept[tile];
+        // Filled and counted in locals and stored once (see the collection above).
+        std::vector<FragmentNode> list = std::move(st.sort_scratch[worker]);
+        std::vector<FragmentNode> kept = std::move(st.list_kept[tile]);
         kept.clear();
-        // Counted in locals and stored once: neighbouring tiles' entries share cache lines, and
-        // a store per pixel made the two workers' tiles fight over them.
         uint32_t tile_longest = 0;
         uint64_t tile_hidden = 0;
         for (uint32_t y = r.y0; y < r.y1; ++y)
@@ -551,6 +557,8 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                 }
                 out.offsets[p + 1] = count;
             }
+        st.sort_scratch[worker] = std::move(list);
+        st.list_kept[tile] = std::move(kept);
         longest[tile] = tile_longest;
         hidden[tile] = tile_hidden;
     });
