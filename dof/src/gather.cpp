@@ -420,8 +420,16 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
     auto t0 = std::chrono::steady_clock::now();
     runTasks(pool, tiles, [&](uint32_t tile, uint32_t) {
         const auto [x0, y0, x1, y1] = p.bounds(tile);
-        TileCoc& tc = tile_coc[tile];
+        // The tile's statistics and reach blocks are kept in locals and stored once per block
+        // or tile: neighbouring tiles' entries share cache lines, and a store per pixel made
+        // the two workers fight over them. The max operations run in the same order.
+        TileCoc tc = tile_coc[tile];
         for (uint32_t y = y0; y < y1; ++y) {
+            float& vb_slot = vblock[size_t(tile % p.tiles_x) * p.row_blocks + y / kBlock];
+            float vb = vb_slot;
+            float* hb_row = hblock.data() + size_t(y) * p.col_blocks;
+            uint32_t hb_block = x0 / kBlock;
+            float hb = hb_row[hb_block];
             for (uint32_t x = x0; x < x1; ++x) {
                 const size_t i = size_t(y) * p.width + x;
                 PixelTerms t{};
@@ -442,12 +450,18 @@ Result<GatherStats> gather(const GatherImage& image, const ThinLens& lens, const
                 tc.min_c = std::min(tc.min_c, t.coc);
                 tc.max_c = std::max(tc.max_c, t.coc);
                 tc.clamped += std::fabs(t.coc) > settings.max_radius_px ? 1u : 0u;
-                float& vb = vblock[size_t(tile % p.tiles_x) * p.row_blocks + y / kBlock];
-                float& hb = hblock[size_t(y) * p.col_blocks + x / kBlock];
+                if (x / kBlock != hb_block) {
+                    hb_row[hb_block] = hb;
+                    hb_block = x / kBlock;
+                    hb = hb_row[hb_block];
+                }
                 vb = std::max(vb, t.radius);
                 hb = std::max(hb, t.radius);
             }
+            hb_row[hb_block] = hb;
+            vb_slot = vb;
         }
+        tile_coc[tile] = tc;
     });
     size_t first_bad = SIZE_MAX;
     bool first_bad_depth = false;
