@@ -4,7 +4,6 @@
 #include <dof/frame_renderer.h>
 #include <raster/fragment_lists.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -67,35 +66,28 @@ void addStats(raster::FrameStats& sum, const raster::FrameStats& one) {
     sum.target_bytes = std::max(sum.target_bytes, one.target_bytes);
 }
 
-// Rows per task of the copies into the caller's image: a copy by one thread would be serial
-// time in every frame.
-constexpr uint32_t kCopyRows = 16;
-
-// Copies width x height RGBA pixels (rows of width*4 floats) into the caller's rows.
+// Copies width x height RGBA pixels (rows of width*4 floats) into the caller's rows, a row per
+// task: a copy by one thread would be serial time in every frame.
 void copyRows(raster::TaskPool& pool, const float* src, uint32_t width, uint32_t height,
               const FrameImage& image) {
     const size_t row = size_t(width) * 4;
-    pool.parallelFor((height + kCopyRows - 1) / kCopyRows, [&](uint32_t task, uint32_t) {
-        for (uint32_t y = task * kCopyRows; y < std::min(height, (task + 1) * kCopyRows); ++y)
-            std::memcpy(image.rgba + size_t(y) * image.stride, src + size_t(y) * row,
-                        row * sizeof(float));
+    pool.parallelFor(height, [&](uint32_t y, uint32_t) {
+        std::memcpy(image.rgba + size_t(y) * image.stride, src + size_t(y) * row,
+                    row * sizeof(float));
     });
 }
 
 // The distance along the view axis of each stored depth D (+inf where D >= kFarDepth when
-// `empty_is_infinite`), into the caller's depth rows.
+// `empty_is_infinite`), into the caller's depth rows, a row per task.
 void writeDepth(raster::TaskPool& pool, const raster::View& view, const raster::DepthBuffer& depth,
                 bool empty_is_infinite, const FrameImage& image) {
-    const uint32_t height = view.height;
-    pool.parallelFor((height + kCopyRows - 1) / kCopyRows, [&](uint32_t task, uint32_t) {
-        for (uint32_t y = task * kCopyRows; y < std::min(height, (task + 1) * kCopyRows); ++y) {
-            float* row = image.depth + size_t(y) * image.depth_stride;
-            for (uint32_t x = 0; x < view.width; ++x) {
-                const float d = depth.load(size_t(y) * view.width + x);
-                row[x] = empty_is_infinite && !(d < raster::kFarDepth)
-                             ? INFINITY
-                             : raster::distanceFromDepth(view, d);
-            }
+    pool.parallelFor(view.height, [&](uint32_t y, uint32_t) {
+        float* row = image.depth + size_t(y) * image.depth_stride;
+        for (uint32_t x = 0; x < view.width; ++x) {
+            const float d = depth.load(size_t(y) * view.width + x);
+            row[x] = empty_is_infinite && !(d < raster::kFarDepth)
+                         ? INFINITY
+                         : raster::distanceFromDepth(view, d);
         }
     });
 }
@@ -472,10 +464,11 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         return s;
     copyRows(pool_, multilayer_image_.rgba.data(), view.width, view.height, image);
     if (image.depth)
-        for (uint32_t y = 0; y < view.height; ++y)
+        pool_.parallelFor(view.height, [&](uint32_t y, uint32_t) {
             std::memcpy(image.depth + size_t(y) * image.depth_stride,
                         multilayer_image_.depth.data() + size_t(y) * view.width,
                         size_t(view.width) * sizeof(float));
+        });
     report.stage_ms = {
         {"collect", st.ms_collect}, {"filter", st.ms_filter}, {"accumulate", st.ms_accumulate}};
     return observed({});
