@@ -250,11 +250,12 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
     out.width = view.width;
     out.height = view.height;
     const size_t pixels = size_t(view.width) * view.height;
-    out.color.resize(pixels * 4); // each tile fills its pixels with the background below
-    out.depth.resize(options.depth_format, view.width, view.height);
+    // Sized here, cleared by each tile's owner below.
+    out.color.resize(pixels * 4);
+    out.depth.resizeUncleared(options.depth_format, view.width, view.height);
     const bool transparency = st.ctx.blend_last; // the scene has BLEND materials
-    out.transparent_depth.resize(options.depth_format, transparency ? view.width : 0,
-                                 transparency ? view.height : 0);
+    out.transparent_depth.resizeUncleared(options.depth_format, transparency ? view.width : 0,
+                                          transparency ? view.height : 0);
     if (options.peel_depth &&
         (options.peel_depth->format != options.depth_format ||
          options.peel_depth->width != view.width || options.peel_depth->height != view.height))
@@ -262,13 +263,18 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
 
     const auto t0 = std::chrono::steady_clock::now();
     pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
-        // The background, filled by the tile's owner rather than by one thread before the tiles.
+        // The background and the far depth, filled by the tile's owner rather than by one
+        // thread before the tiles.
         const TileRect r = tileRect(st.ctx.grid, tile);
         for (uint32_t y = r.y0; y < r.y1; ++y) {
-            float* c = out.color.data() + (size_t(y) * view.width + r.x0) * 4;
+            const size_t i = size_t(y) * view.width + r.x0;
+            float* c = out.color.data() + i * 4;
             for (uint32_t x = r.x0; x < r.x1; ++x, c += 4)
                 c[0] = scene.background.r, c[1] = scene.background.g, c[2] = scene.background.b,
                 c[3] = 1.0f;
+            out.depth.fill(i, r.x1 - r.x0, kFarDepth);
+            if (transparency)
+                out.transparent_depth.fill(i, r.x1 - r.x0, kFarDepth);
         }
         FrameSink sink{out, options.peel_depth};
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
@@ -314,17 +320,17 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     out.layer_count = layers;
     out.desc = desc;
     const size_t pixels = out.pixelCount();
-    out.color.resize(desc.color_format, pixels * layers, glm::vec4(0.0f));
-    out.depth.resize(desc.depth_format, view.width, view.height * layers);
-    out.gbuffer.assign(desc.gbuffer ? pixels * layers : 0, GSample{});
+    // Sized here, cleared by each tile's owner below.
+    out.color.resizeUncleared(desc.color_format, pixels * layers);
+    out.depth.resizeUncleared(desc.depth_format, view.width, view.height * layers);
+    out.gbuffer.resize(desc.gbuffer ? pixels * layers : 0);
     const bool transparency = st.ctx.blend_last; // the scene has BLEND materials
-    out.transparent_color.resize(desc.color_format, transparency ? pixels * layers : 0,
-                                 glm::vec4(0.0f));
-    out.transparent_depth.resize(desc.depth_format, transparency ? view.width : 0,
-                                 transparency ? view.height * layers : 0);
+    out.transparent_color.resizeUncleared(desc.color_format, transparency ? pixels * layers : 0);
+    out.transparent_depth.resizeUncleared(desc.depth_format, transparency ? view.width : 0,
+                                          transparency ? view.height * layers : 0);
     const bool transparent_gbuffer = transparency && desc.gbuffer;
-    out.transparent_gbuffer.assign(transparent_gbuffer ? pixels * layers : 0, GSample{});
-    out.transparent_top_alpha.assign(transparent_gbuffer ? pixels * layers : 0, 0.0f);
+    out.transparent_gbuffer.resize(transparent_gbuffer ? pixels * layers : 0);
+    out.transparent_top_alpha.resize(transparent_gbuffer ? pixels * layers : 0);
     std::vector<LayerInterval>& intervals = st.layer_intervals;
     intervals.resize(layers);
     for (uint32_t l = 0; l < layers; ++l)
@@ -332,6 +338,26 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
 
     auto t0 = std::chrono::steady_clock::now();
     pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
+        // Every layer's pixels of the tile cleared by the tile's owner, as the frame's background
+        // in render(): nothing, at the far depth.
+        const TileRect r = tileRect(st.ctx.grid, tile);
+        const size_t n = r.x1 - r.x0;
+        for (uint32_t l = 0; l < layers; ++l)
+            for (uint32_t y = r.y0; y < r.y1; ++y) {
+                const size_t i = out.index(l, size_t(y) * view.width + r.x0);
+                out.color.fill(i, n, glm::vec4(0.0f));
+                out.depth.fill(i, n, kFarDepth);
+                if (desc.gbuffer)
+                    std::fill_n(out.gbuffer.data() + i, n, GSample{});
+                if (transparency) {
+                    out.transparent_color.fill(i, n, glm::vec4(0.0f));
+                    out.transparent_depth.fill(i, n, kFarDepth);
+                }
+                if (transparent_gbuffer) {
+                    std::fill_n(out.transparent_gbuffer.data() + i, n, GSample{});
+                    std::fill_n(out.transparent_top_alpha.data() + i, n, 0.0f);
+                }
+            }
         LayerSink sink{out, intervals, desc.gbuffer};
         rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
     });

@@ -50,6 +50,12 @@ struct DepthBuffer {
 
     // Resizes and clears to the far value kFarDepth.
     void resize(DepthFormat depth_format, uint32_t w, uint32_t h);
+    // Resizes without clearing (kept values stay, new ones are 0 in either format), for a
+    // renderer whose tiles each clear their own pixels with fill: the clear then runs on every
+    // thread, while the tile's pixels are about to be written anyway.
+    void resizeUncleared(DepthFormat depth_format, uint32_t w, uint32_t h);
+    // Sets the `count` values from index `first` to d.
+    void fill(size_t first, size_t count, float d);
     // D at pixel index i, as a float in [-1, 0].
     float load(size_t i) const {
         return format == DepthFormat::Float32 ? float32[i] : decodeUnorm16(unorm16[i]);
@@ -74,6 +80,10 @@ struct ColorBuffer {
 
     // Resizes to `pixels` RGBA values, all set to `clear`.
     void resize(ColorFormat color_format, size_t pixels, glm::vec4 clear);
+    // Resizes without clearing, as DepthBuffer::resizeUncleared, and sets the `count` colours
+    // from pixel `first` to c.
+    void resizeUncleared(ColorFormat color_format, size_t pixels);
+    void fill(size_t first, size_t count, glm::vec4 c);
     glm::vec4 load(size_t i) const {
         if (format == ColorFormat::Float32)
             return {float32[4 * i], float32[4 * i + 1], float32[4 * i + 2], float32[4 * i + 3]};
