@@ -56,13 +56,27 @@ Status checkRange(const DepthRange& range) {
 } // namespace
 
 DepthRange visibleDepthRange(const raster::Frame& pinhole, const raster::View& view) {
-    // One pass in pixel order (BLEND surfaces included): min/max are order-independent, so this
-    // is deterministic.
     DepthRange r;
+    // distanceFromDepth never decreases as D grows, so when both ends of the stored depths give
+    // valid distances, every depth between them does and the ends are the range.
+    const raster::VisibleDepthBounds b = raster::visibleDepthBounds(pinhole);
+    if (!b.any)
+        return r;
+    const float near_d = raster::distanceFromDepth(view, b.min);
+    const float far_d = raster::distanceFromDepth(view, b.max);
+    auto valid = [](float d) { return std::isfinite(d) && d > 0.0f; };
+    if (valid(near_d) && valid(far_d)) {
+        r.near_d = near_d;
+        r.far_d = far_d;
+        r.covered = true;
+        return r;
+    }
+    // Otherwise (an infinite far end): one pass in pixel order over the valid distances; min and
+    // max are order-independent, so this is deterministic.
     float lo = INFINITY, hi = 0.0f;
     raster::forEachVisibleDepth(pinhole, [&](float stored) {
         const float d = raster::distanceFromDepth(view, stored);
-        if (!std::isfinite(d) || !(d > 0.0f))
+        if (!valid(d))
             return;
         lo = std::min(lo, d);
         hi = std::max(hi, d);

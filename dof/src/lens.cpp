@@ -85,15 +85,29 @@ raster::Result<float> focusDistanceAtPixel(const raster::Frame& pinhole, const r
 CocRange visibleCocRange(const ThinLens& lens, const raster::Frame& pinhole,
                          const raster::View& view) {
     CocRange r;
-    raster::forEachVisibleDepth(pinhole, [&](float stored) {
-        const float c = cocRadiusPx(lens, raster::distanceFromDepth(view, stored));
-        if (!r.covered) {
-            r.min_px = r.max_px = c;
-            r.covered = true;
-        }
-        r.min_px = std::fmin(r.min_px, c);
-        r.max_px = std::fmax(r.max_px, c);
-    });
+    const raster::VisibleDepthBounds b = raster::visibleDepthBounds(pinhole);
+    if (!b.any)
+        return r;
+    // With E f_px > 0, C never decreases as d grows, nor d as D grows (distanceFromDepth), so
+    // the stored depths' ends give C's: two evaluations instead of one per pixel, the same bits.
+    const float lo = cocRadiusPx(lens, raster::distanceFromDepth(view, b.min));
+    const float hi = cocRadiusPx(lens, raster::distanceFromDepth(view, b.max));
+    const float scale = lens.aperture_radius * lens.focal_length_px;
+    if (std::isfinite(scale) && scale > 0.0f && !std::isnan(lo) && !std::isnan(hi)) {
+        r.min_px = lo;
+        r.max_px = hi;
+        r.covered = true;
+    } else { // a zero or invalid lens: every pixel, in pixel order
+        raster::forEachVisibleDepth(pinhole, [&](float stored) {
+            const float c = cocRadiusPx(lens, raster::distanceFromDepth(view, stored));
+            if (!r.covered) {
+                r.min_px = r.max_px = c;
+                r.covered = true;
+            }
+            r.min_px = std::fmin(r.min_px, c);
+            r.max_px = std::fmax(r.max_px, c);
+        });
+    }
     r.max_abs_px = std::fmax(std::fabs(r.min_px), std::fabs(r.max_px));
     return r;
 }

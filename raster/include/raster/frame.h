@@ -5,6 +5,8 @@
 #include <raster/memory_budget.h>
 #include <raster/storage.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -42,6 +44,26 @@ template <class Fn> void forEachVisibleDepth(const Frame& frame, Fn&& fn) {
             if (const float d = frame.transparent_depth.load(i); d < kFarDepth)
                 fn(d);
     }
+}
+
+// The smallest and largest of those depths (none: `any` false). A function that never decreases
+// as D grows, such as distanceFromDepth, takes its extremes over the visible depths at these two,
+// so a frame-wide range needs one division at each end instead of one per pixel.
+struct VisibleDepthBounds {
+    float min = kFarDepth, max = kFarDepth; // kFarDepth when none
+    bool any = false;
+};
+inline VisibleDepthBounds visibleDepthBounds(const Frame& frame) {
+    VisibleDepthBounds b;
+    b.min = INFINITY, b.max = -INFINITY;
+    forEachVisibleDepth(frame, [&](float d) {
+        b.min = std::min(b.min, d);
+        b.max = std::max(b.max, d);
+        b.any = true;
+    });
+    if (!b.any)
+        b.min = b.max = kFarDepth;
+    return b;
 }
 
 } // namespace raster

@@ -1,11 +1,15 @@
 // dof/lens.h: the thin-lens CoC, its signs, the photographic mapping and validation.
 #include "dof_test_util.h"
 
+#include <dof/layer_spacing.h>
 #include <dof/lens.h>
+#include <raster/frame.h>
+#include <scenes/builtin.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string_view>
 
 namespace focal::test {
 namespace {
@@ -72,6 +76,45 @@ TEST(Lens, FocusDistanceAtPixel) {
     EXPECT_TRUE(range.covered);
     EXPECT_NEAR(range.max_px, 1.0f, 1e-3f); // 3 * 100 * (1/100 - 1/150)
     EXPECT_NEAR(range.min_px, 1.0f, 1e-3f);
+}
+
+// visibleCocRange and visibleDepthRange take their ends from the extreme stored depths: the same
+// bits as folding every visible pixel's value (opaque and BLEND), for lenses focused in front of,
+// inside and behind the scene.
+TEST(Lens, VisibleRangesMatchEveryPixelsExtremes) {
+    for (const char* name : {"demo", "glass", "dense"}) {
+        raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(name);
+        ASSERT_TRUE(scene.ok()) << name;
+        const raster::View view = raster::viewFromCamera(scene->cameras[0], 96, 64);
+        const raster::Frame f = render(*scene, view);
+        if (std::string_view(name) == "glass") { // BLEND surfaces are visible depths too
+            ASSERT_GT(f.transparent_depth.bytes(), 0u);
+        }
+        float d_lo = INFINITY, d_hi = 0.0f;
+        raster::forEachVisibleDepth(f, [&](float stored) {
+            const float d = raster::distanceFromDepth(view, stored);
+            d_lo = std::min(d_lo, d);
+            d_hi = std::max(d_hi, d);
+        });
+        const dof::DepthRange depths = dof::visibleDepthRange(f, view);
+        ASSERT_TRUE(depths.covered) << name;
+        EXPECT_EQ(depths.near_d, d_lo) << name;
+        EXPECT_EQ(depths.far_d, d_hi) << name;
+        for (float focus : {0.5f * d_lo, 0.5f * (d_lo + d_hi), 2.0f * d_hi}) {
+            const dof::ThinLens lens = dof::makeThinLens(view, 0.05f, focus);
+            float c_lo = INFINITY, c_hi = -INFINITY;
+            raster::forEachVisibleDepth(f, [&](float stored) {
+                const float c = dof::cocRadiusPx(lens, raster::distanceFromDepth(view, stored));
+                c_lo = std::fmin(c_lo, c);
+                c_hi = std::fmax(c_hi, c);
+            });
+            const dof::CocRange coc = dof::visibleCocRange(lens, f, view);
+            ASSERT_TRUE(coc.covered) << name;
+            EXPECT_EQ(coc.min_px, c_lo) << name << " focus " << focus;
+            EXPECT_EQ(coc.max_px, c_hi) << name << " focus " << focus;
+            EXPECT_LT(c_lo, c_hi) << name; // a range of depths, not one
+        }
+    }
 }
 
 } // namespace
