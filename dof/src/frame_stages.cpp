@@ -555,12 +555,18 @@ void FrameRenderer::multiviewStages(const raster::View& view, const ThinLens& le
         b.count("cone_partial", double(st.cone_partial));
         b.count("cone_missed", double(st.cone_missed));
         const MultiviewScratch& s = multiview_scratch_;
+        std::vector<float> level; // the whole level: the rows it does not store are 0
         for (size_t l = 0; l < s.mips.size(); ++l)
             for (size_t n = 0; n < s.mips[l].size() && n < s.mip_width.size(); ++n)
-                if (!s.mips[l][n].empty())
+                if (!s.mips[l][n].empty()) {
+                    level.assign(size_t(s.mip_width[n]) * s.mip_height[n] * 4, 0.0f);
+                    std::copy(s.mips[l][n].begin(), s.mips[l][n].end(),
+                              level.begin() +
+                                  ptrdiff_t(size_t(s.mip_row0[l][n]) * s.mip_width[n] * 4));
                     b.color(layerName(uint32_t(l)) + " level " + std::to_string(n),
-                            "premultiplied RGBA, alpha = coverage", s.mips[l][n].data(),
-                            s.mip_width[n], s.mip_height[n], 1u << n);
+                            "premultiplied RGBA, alpha = coverage", level.data(), s.mip_width[n],
+                            s.mip_height[n], 1u << n);
+                }
         b.send(observer);
     }
     {

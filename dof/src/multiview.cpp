@@ -199,7 +199,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     stats.ms_nbuffer = msSince(t0);
 
     t0 = Clock::now();
-    buildMipmaps(tr, reach_max, pool, scratch, stats);
+    buildMipmaps(tr, fs.content, reach_max, pool, scratch, stats);
     buildFirstRays(tr);
     stats.ms_mipmaps = msSince(t0);
     for (uint32_t l = 0; l < m; ++l) {

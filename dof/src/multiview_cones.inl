@@ -32,21 +32,26 @@ std::array<float, C> sampleMip(const MipChain& mip, float px, float py, MipLevel
         const float* r0;
         const float* r1;
         int64_t x0, x1;
-        if (fu >= 0.0f && fv >= 0.0f && fu < m.last_u && fv < m.last_v) {
-            // Inside the level: the four texels need no clamping (the usual case).
+        if (fu >= 0.0f && fv >= m.first_v && fu < m.last_u && fv < m.stored_v) {
+            // Inside the level's stored rows: the four texels need no clamping (the usual case).
             x0 = int64_t(fu) * Stride;
             x1 = x0 + Stride;
-            r0 = m.data + size_t(int64_t(fv) * w) * Stride;
+            r0 = m.data + size_t((int64_t(fv) - m.row0) * w) * Stride;
             r1 = r0 + size_t(w) * Stride;
         } else {
             // Clamped to the level (the position may lie far outside it when a clamped ray
-            // read a border texel).
+            // read a border texel); a row the level does not store is 0.
             const int64_t iu = int64_t(std::clamp(fu, -1.0f, float(w)));
             const int64_t iv = int64_t(std::clamp(fv, -1.0f, float(h)));
             x0 = std::clamp<int64_t>(iu, 0, w - 1) * Stride;
             x1 = std::clamp<int64_t>(iu + 1, 0, w - 1) * Stride;
-            r0 = m.data + size_t(std::clamp<int64_t>(iv, 0, h - 1) * w) * Stride;
-            r1 = m.data + size_t(std::clamp<int64_t>(iv + 1, 0, h - 1) * w) * Stride;
+            const auto row = [&](int64_t y) {
+                y = std::clamp<int64_t>(y, 0, h - 1);
+                return y >= m.row0 && y < m.row1 ? m.data + size_t((y - m.row0) * w) * Stride
+                                                 : m.zero;
+            };
+            r0 = row(iv);
+            r1 = row(iv + 1);
         }
         const float bu = 1.0f - au, bv = 1.0f - av;
         Taps out;

@@ -9,6 +9,9 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
+#include <bit>
+
 namespace dof::multiview_detail {
 
 using raster::Status;
@@ -53,30 +56,47 @@ void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool
     content.min.assign(m, INFINITY);
     content.max.assign(m, -INFINITY);
     content.transparent.assign(m, 0);
+    content.row0.assign(m, 0);
+    content.row1.assign(m, 0);
+    content.transparent_row0.assign(m, 0);
+    content.transparent_row1.assign(m, 0);
+    const uint32_t width = layers.width, height = layers.height;
     pool.parallelFor(m, [&](uint32_t l, uint32_t) {
         float lo = INFINITY, hi = -INFINITY;
-        // Returns whether any texel is covered.
+        // Returns whether any texel is covered; [row0, row1): the rows with a texel not +0.
         auto copy = [&](const raster::ColorBuffer& color, const raster::DepthBuffer& depth,
-                        std::vector<float>& d) {
+                        std::vector<float>& d, uint32_t& row0, uint32_t& row1) {
             d.resize(pixels);
             bool any = false;
-            for (size_t i = 0; i < pixels; ++i) {
-                const size_t li = layers.index(l, i);
-                const bool covered = color.load(li).a > 0.0f;
-                const float v = covered ? depth.load(li) : kEmptyDepth;
-                d[i] = v;
-                if (covered) {
-                    lo = std::min(lo, v);
-                    hi = std::max(hi, v);
-                    any = true;
+            for (uint32_t y = 0; y < height; ++y) {
+                bool drawn = false;
+                for (size_t i = size_t(y) * width, end = i + width; i < end; ++i) {
+                    const size_t li = layers.index(l, i);
+                    const glm::vec4 c = color.load(li);
+                    const bool covered = c.a > 0.0f;
+                    const float v = covered ? depth.load(li) : kEmptyDepth;
+                    d[i] = v;
+                    // Not the clear value +0: the mipmaps' level 0 may differ from +0 here.
+                    drawn |= (std::bit_cast<uint32_t>(c.r) | std::bit_cast<uint32_t>(c.g) |
+                              std::bit_cast<uint32_t>(c.b) | std::bit_cast<uint32_t>(c.a)) != 0;
+                    if (covered) {
+                        lo = std::min(lo, v);
+                        hi = std::max(hi, v);
+                        any = true;
+                    }
+                }
+                if (drawn) {
+                    row0 = row1 == 0 ? y : row0;
+                    row1 = y + 1;
                 }
             }
             return any;
         };
-        copy(layers.color, layers.depth, scratch.depth[l]);
+        copy(layers.color, layers.depth, scratch.depth[l], content.row0[l], content.row1[l]);
         if (transparency)
             content.transparent[l] = copy(layers.transparent_color, layers.transparent_depth,
-                                          scratch.transparent_depth[l]);
+                                          scratch.transparent_depth[l], content.transparent_row0[l],
+                                          content.transparent_row1[l]);
         content.min[l] = lo;
         content.max[l] = hi;
     });
@@ -179,13 +199,12 @@ void buildNBuffers(const Tracer& tr, raster::TaskPool& pool, MultiviewScratch& s
     }
 }
 
-void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, MultiviewScratch& scratch,
-                  MultiviewStats& stats) {
+void buildMipmaps(Tracer& tr, const LayerContent& content, float reach_max, raster::TaskPool& pool,
+                  MultiviewScratch& scratch, MultiviewStats& stats) {
     const raster::LayeredTarget& layers = *tr.layers;
     const MultiviewSettings& settings = *tr.settings;
     const uint32_t width = tr.width, height = tr.height;
     const uint32_t m = uint32_t(tr.segs.size());
-    const size_t pixels = size_t(width) * height;
     const bool transparency = layers.hasTransparency();
     // Per layer, the levels built below (cleared for the layers that build none).
     auto keepLayers = [&](std::vector<std::vector<std::vector<float>>>& mips, bool used) {
@@ -197,6 +216,8 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
     keepLayers(scratch.mips, true);
     keepLayers(scratch.transparent_mips, transparency);
     keepLayers(scratch.owned_mips, settings.cone && settings.cone_misses);
+    scratch.mip_row0.resize(m);
+    scratch.transparent_mip_row0.resize(transparency ? m : 0);
     scratch.owned_empty_blocks.resize(scratch.owned_mips.size());
     for (std::vector<uint8_t>& blocks : scratch.owned_empty_blocks)
         blocks.clear(); // rebuilt below for the layers with missed cones
@@ -217,6 +238,7 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
             scratch.mip_height.push_back(std::max(1u, (scratch.mip_height.back() + 1) / 2));
         }
         stats.mip_levels = levels;
+        tr.zero_row.resize(size_t(width) * kOwnedChannels);
         for (LayerSeg& seg : tr.segs)
             if (seg.cone_px > 0.0f) {
                 seg.cone_level = mipLevelFor(tr, tr.lambda * std::fabs(tr.cocOf(seg.t_cone)));
@@ -224,25 +246,58 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
                 seg.first_cone_px = tr.r_max * std::fabs(tr.cocOf(seg.t_cone)) +
                                     1.5f * std::ldexp(1.0f, int(seg.cone_level.l1)) + 1.0f;
             }
-        // Level 0 from `level0` (C channels per texel), then 2x2 box reductions.
-        auto build = [&]<uint32_t C>(std::vector<std::vector<float>>& mip, auto&& level0) {
-            mip.resize(levels);
-            mip[0].resize(pixels * C);
-            for (size_t i = 0; i < pixels; ++i) {
-                const auto c = level0(i);
-                for (uint32_t k = 0; k < C; ++k)
-                    mip[0][i * C + k] = c[k];
+        // The rows each level stores: level 0 the layer's rows [row0, row1) whose texels are not
+        // +0 (every other texel of level 0 is +0), then the rows a 2x2 reduction of those can
+        // reach; a level's other rows average four +0 texels, +0 too.
+        auto planRows = [&](std::vector<uint32_t>& first, uint32_t row0, uint32_t row1) {
+            first.resize(levels);
+            uint32_t end = row1;
+            for (uint32_t lv = 0; lv < levels; ++lv) {
+                if (lv > 0 && end > row0) {
+                    row0 /= 2;
+                    end = std::min((end - 1) / 2 + 1, scratch.mip_height[lv]);
+                }
+                first[lv] = end > row0 ? row0 : 0;
+                if (end <= row0)
+                    row0 = end = 0;
             }
+        };
+        // Level 0 from `level0` (C channels per texel) on its stored rows, then 2x2 box
+        // reductions; a source row a level does not store is read as zeros.
+        auto build = [&]<uint32_t C>(std::vector<std::vector<float>>& mip,
+                                     const std::vector<uint32_t>& first, uint32_t row1,
+                                     auto&& level0) {
+            mip.resize(levels);
+            uint32_t end = row1;
+            {
+                const uint32_t row0 = first[0];
+                end = row1 > row0 ? row1 : row0;
+                mip[0].resize(size_t(end - row0) * width * C);
+                for (size_t i = size_t(row0) * width, o = 0; i < size_t(end) * width; ++i, ++o) {
+                    const auto c = level0(i);
+                    for (uint32_t k = 0; k < C; ++k)
+                        mip[0][o * C + k] = c[k];
+                }
+            }
+            uint32_t prev0 = first[0], prev1 = end;
             for (uint32_t lv = 1; lv < levels; ++lv) {
                 const uint32_t pw = scratch.mip_width[lv - 1], ph = scratch.mip_height[lv - 1];
-                const uint32_t cw = scratch.mip_width[lv], ch = scratch.mip_height[lv];
+                const uint32_t cw = scratch.mip_width[lv];
+                const uint32_t row0 = first[lv];
+                const uint32_t row_end =
+                    prev1 > prev0 ? std::min((prev1 - 1) / 2 + 1, scratch.mip_height[lv]) : row0;
                 const std::vector<float>& src = mip[lv - 1];
                 std::vector<float>& dst = mip[lv];
-                dst.resize(size_t(cw) * ch * C);
-                for (uint32_t y = 0; y < ch; ++y) {
-                    const float* r0 = src.data() + size_t(std::min(2 * y, ph - 1)) * pw * C;
-                    const float* r1 = src.data() + size_t(std::min(2 * y + 1, ph - 1)) * pw * C;
-                    float* o = dst.data() + size_t(y) * cw * C;
+                dst.resize(size_t(row_end - row0) * cw * C);
+                auto srcRow = [&](uint32_t y) {
+                    y = std::min(y, ph - 1);
+                    return y >= prev0 && y < prev1 ? src.data() + size_t(y - prev0) * pw * C
+                                                   : tr.zero_row.data();
+                };
+                for (uint32_t y = row0; y < row_end; ++y) {
+                    const float* r0 = srcRow(2 * y);
+                    const float* r1 = srcRow(2 * y + 1);
+                    float* o = dst.data() + size_t(y - row0) * cw * C;
                     auto texel = [&](uint32_t x, uint32_t x0, uint32_t x1) {
                         for (uint32_t c = 0; c < C; ++c)
                             o[x * C + c] = 0.25f * (r0[x0 * C + c] + r0[x1 * C + c] +
@@ -254,12 +309,16 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
                     for (uint32_t x = pw / 2; x < cw; ++x)
                         texel(x, std::min(2 * x, pw - 1), std::min(2 * x + 1, pw - 1));
                 }
+                prev0 = row0;
+                prev1 = row_end;
             }
         };
         pool.parallelFor(m, [&](uint32_t l, uint32_t) {
             if (tr.segs[l].empty)
                 return;
-            build.template operator()<4>(scratch.mips[l], [&](size_t i) {
+            planRows(scratch.mip_row0[l], content.row0[l], content.row1[l]);
+            const std::vector<uint32_t>& first = scratch.mip_row0[l];
+            build.template operator()<4>(scratch.mips[l], first, content.row1[l], [&](size_t i) {
                 // coverage alpha: 1 where covered
                 const glm::vec4 c = layers.color.load(layers.index(l, i));
                 const float a = c.a > 0.0f ? 1.0f : 0.0f;
@@ -268,48 +327,75 @@ void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, Multiview
             if (settings.cone_misses) { // the texels the layer owns (missCone)
                 const float lo = tr.segs[l].own0, hi = tr.segs[l].own1;
                 const bool last = l + 1 == m;
-                build.template operator()<kOwnedChannels>(scratch.owned_mips[l], [&](size_t i) {
-                    const float d = scratch.depth[l][i];
-                    const bool owned = d >= lo && (d < hi || (last && d <= hi));
-                    const glm::vec4 c = layers.color.load(layers.index(l, i));
-                    return owned ? std::array<float, kOwnedChannels>{d, 1.0f, c.r, c.g, c.b}
-                                 : std::array<float, kOwnedChannels>{};
-                });
+                build.template operator()<kOwnedChannels>(
+                    scratch.owned_mips[l], first, content.row1[l], [&](size_t i) {
+                        const float d = scratch.depth[l][i];
+                        const bool owned = d >= lo && (d < hi || (last && d <= hi));
+                        const glm::vec4 c = layers.color.load(layers.index(l, i));
+                        return owned ? std::array<float, kOwnedChannels>{d, 1.0f, c.r, c.g, c.b}
+                                     : std::array<float, kOwnedChannels>{};
+                    });
                 std::vector<uint8_t>& blocks = scratch.owned_empty_blocks[l];
                 if (tr.segs[l].cone_px > 0.0f) {
                     // mipEmptyAt's four coverage taps, tested once per block here instead of
                     // once per missed ray: one byte read, from a map that stays in the cache.
+                    // Rows the level does not store have no coverage.
                     const uint32_t lv = tr.segs[l].cone_last_level;
                     const size_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
-                    const float* cov = scratch.owned_mips[l][lv].data() + 1;
-                    const size_t row = w * kOwnedChannels;
+                    const size_t row0 = first[lv];
+                    const size_t rows = scratch.owned_mips[l][lv].size() / (w * kOwnedChannels);
+                    auto coverage = [&](size_t v) {
+                        return (v >= row0 && v < row0 + rows ? scratch.owned_mips[l][lv].data() +
+                                                                   (v - row0) * w * kOwnedChannels
+                                                             : tr.zero_row.data()) +
+                               1;
+                    };
                     blocks.assign(w * h, 0);
-                    for (size_t v = 0; v + 1 < h; ++v)
+                    for (size_t v = 0; v + 1 < h; ++v) {
+                        const float* c0 = coverage(v);
+                        const float* c1 = coverage(v + 1);
                         for (size_t u = 0; u + 1 < w; ++u) {
-                            const float* t = cov + (v * w + u) * kOwnedChannels;
-                            blocks[v * w + u] = t[0] == 0.0f && t[kOwnedChannels] == 0.0f &&
-                                                t[row] == 0.0f && t[row + kOwnedChannels] == 0.0f;
+                            const size_t k = u * kOwnedChannels;
+                            blocks[v * w + u] = c0[k] == 0.0f && c0[k + kOwnedChannels] == 0.0f &&
+                                                c1[k] == 0.0f && c1[k + kOwnedChannels] == 0.0f;
                         }
+                    }
                 }
             }
-            if (transparency) // already premultiplied, alpha = opacity
-                build.template operator()<4>(scratch.transparent_mips[l], [&](size_t i) {
-                    return layers.transparent_color.load(layers.index(l, i));
-                });
+            if (transparency) { // already premultiplied, alpha = opacity
+                planRows(scratch.transparent_mip_row0[l], content.transparent_row0[l],
+                         content.transparent_row1[l]);
+                build.template operator()<4>(
+                    scratch.transparent_mips[l], scratch.transparent_mip_row0[l],
+                    content.transparent_row1[l],
+                    [&](size_t i) { return layers.transparent_color.load(layers.index(l, i)); });
+            }
         });
     }
     auto views = [&](const std::vector<std::vector<std::vector<float>>>& layer_mips,
+                     const std::vector<std::vector<uint32_t>>& row0, uint32_t channels,
                      std::vector<MipChain>& chains) {
         chains.assign(layer_mips.size(), MipChain{});
         for (size_t l = 0; l < layer_mips.size(); ++l)
             for (size_t lv = 0; lv < layer_mips[l].size(); ++lv) {
                 const int64_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
-                chains[l][lv] = {layer_mips[l][lv].data(), w, h, float(w - 1), float(h - 1)};
+                const int64_t r0 = row0[l][lv];
+                const int64_t r1 = r0 + int64_t(layer_mips[l][lv].size() / (size_t(w) * channels));
+                chains[l][lv] = {layer_mips[l][lv].data(),
+                                 tr.zero_row.data(),
+                                 w,
+                                 h,
+                                 r0,
+                                 r1,
+                                 float(w - 1),
+                                 float(h - 1),
+                                 float(r0),
+                                 float(r1 - 1)};
             }
     };
-    views(scratch.mips, tr.mips);
-    views(scratch.owned_mips, tr.owned_mips);
-    views(scratch.transparent_mips, tr.transparent_mips);
+    views(scratch.mips, scratch.mip_row0, 4, tr.mips);
+    views(scratch.owned_mips, scratch.mip_row0, kOwnedChannels, tr.owned_mips);
+    views(scratch.transparent_mips, scratch.transparent_mip_row0, 4, tr.transparent_mips);
     for (uint32_t l = 0; l < scratch.owned_empty_blocks.size(); ++l)
         tr.segs[l].cone_empty_blocks =
             scratch.owned_empty_blocks[l].empty() ? nullptr : scratch.owned_empty_blocks[l].data();

@@ -11,10 +11,13 @@
 
 namespace dof::multiview_detail {
 
-// The extent of each layer's covered texels in stored D (copyLayerDepths).
+// The extent of each layer's covered texels in stored D, and of its drawn rows (copyLayerDepths).
 struct LayerContent {
     std::vector<float> min, max;      // +inf and -inf when the layer is empty
     std::vector<uint8_t> transparent; // whether its transparent plane has content
+    // Rows [row0, row1) of the layer (of its transparent plane) hold every texel whose colour is
+    // not the target's clear value, +0 in every channel; none: 0, 0.
+    std::vector<uint32_t> row0, row1, transparent_row0, transparent_row1;
 };
 
 // The lens cells of one sample set (multiview_lens_cells.cpp): lambda (meanNeighbourDistance)
@@ -69,9 +72,10 @@ void buildNBuffers(const Tracer& tr, raster::TaskPool& pool, MultiviewScratch& s
                    std::vector<std::vector<float>>& nearest, MultiviewStats& stats);
 
 // The coverage, owned and transparent mipmaps (§4.4) in scratch, their views in tr, and each
-// segment's first missed-cone lookup.
-void buildMipmaps(Tracer& tr, float reach_max, raster::TaskPool& pool, MultiviewScratch& scratch,
-                  MultiviewStats& stats);
+// segment's first missed-cone lookup. Each level stores only the rows `content`'s drawn rows
+// reach (MultiviewScratch::mip_row0).
+void buildMipmaps(Tracer& tr, const LayerContent& content, float reach_max, raster::TaskPool& pool,
+                  MultiviewScratch& scratch, MultiviewStats& stats);
 
 // With the shared sample set (JitterMode::None): tr.first_rays, every ray's starting state.
 void buildFirstRays(Tracer& tr);

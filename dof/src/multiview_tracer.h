@@ -44,10 +44,16 @@ struct MipLevel {
 };
 
 // One level of a layer mipmap (MultiviewScratch) as the lookups read it, flattened per frame.
+// The level stores its rows [row0, row1) only (MultiviewScratch::mip_row0); the others are 0,
+// read from `zero`, a row of zeros at least as wide.
 struct MipView {
-    const float* data = nullptr;
+    const float* data = nullptr; // row row0
+    const float* zero = nullptr;
     int64_t width = 0, height = 0;
+    int64_t row0 = 0, row1 = 0;
     float last_u = 0.0f, last_v = 0.0f; // width - 1, height - 1: the last interior taps
+    // Rows v and v + 1 are both stored when first_v <= v < stored_v (row0 and row1 - 1).
+    float first_v = 0.0f, stored_v = 0.0f;
 };
 using MipChain = std::array<MipView, kMaxMipLevels>;
 
@@ -165,6 +171,7 @@ struct Tracer {
     std::vector<RayState> first_rays;
     // Per layer: its colour, owned and transparent mipmaps (MultiviewScratch), where built.
     std::vector<MipChain> mips, owned_mips, transparent_mips;
+    std::vector<float> zero_row;  // MipView::zero: a row of the widest level, kOwnedChannels wide
     float thickness_d = INFINITY; // MultiviewSettings::thickness_px as a span of stored depth D
     bool in_focus = false;        // pixels in focus are resolved without tracing (inFocusPixel)
     glm::vec3 background{0.0f};
@@ -185,6 +192,7 @@ struct Tracer {
         keep(mips, fresh.mips);
         keep(owned_mips, fresh.owned_mips);
         keep(transparent_mips, fresh.transparent_mips);
+        fresh.zero_row.swap(zero_row); // kept as it is: zeros
         *this = std::move(fresh);
     }
 

@@ -280,9 +280,13 @@ struct MultiviewScratch {
     std::vector<std::vector<float>> depth; // per layer, stored D; kEmptyDepth where empty
     std::vector<NBuffer> nbuffers;         // per layer (empty when the layer is empty or culling
                                            // is off)
-    // per layer, per level >= 1: premultiplied RGBA (alpha = coverage), level sizes halve
+    // per layer, per level: premultiplied RGBA (alpha = coverage), level sizes halve. A level
+    // stores only its rows from mip_row0[layer][level] on, as many as its size holds: the rows
+    // that can differ from 0 (those of the layer's drawn texels, and the rows of coarser levels
+    // they reach). Every other texel is 0, and the lookups read it so.
     std::vector<std::vector<std::vector<float>>> mips;
     std::vector<uint32_t> mip_width, mip_height; // per level (level 0 = image)
+    std::vector<std::vector<uint32_t>> mip_row0; // per layer, per level: mips and owned_mips
     // per layer, per level: (D a, a, r a, g a, b a) over the texels the layer owns (a = 1 where
     // its depth lies in the layer's own interval, else 0), for the cones of missed rays
     // (MultiviewSettings::cone_misses; empty otherwise)
@@ -296,6 +300,7 @@ struct MultiviewScratch {
     // stored D of the nearest BLEND fragment (kEmptyDepth where none) and premultiplied mipmaps.
     std::vector<std::vector<float>> transparent_depth;
     std::vector<std::vector<std::vector<float>>> transparent_mips;
+    std::vector<std::vector<uint32_t>> transparent_mip_row0; // as mip_row0
     // The rest, private to the method: the layer spacing and description, the tracer's segments,
     // paths and mip views, the tiles' ray states and counters, and the lens cells (lambda and cone
     // centres) of the last sample set, computed again only when the set changes. Made by the

@@ -781,6 +781,82 @@ TEST(Multiview, BuffersKeptBetweenFramesGiveTheSameBytes) {
     }
 }
 
+// The mipmaps store only the rows that can differ from 0 (MultiviewScratch::mip_row0): with
+// the rows they do not store read as 0, every level of the colour and transparent mipmaps is
+// the full pyramid, built here from the layered target bit for bit (level 0: premultiplied
+// colour with coverage alpha, or the transparent plane; then 2x2 means, edges clamped).
+TEST(Multiview, MipmapsStoreEveryRowThatIsNotZero) {
+    raster::TaskPool pool(2);
+    raster::Renderer renderer(pool);
+    const raster::RenderOptions options;
+    const raster::View view = pixelView(72, 56, 100.0f);
+    raster::Scene scene = wallScene();
+    raster::Material glass = flatMaterial({0.2f, 0.4f, 0.9f, 0.4f}, raster::AlphaMode::Blend);
+    addQuad(scene, 0.0f, -20.0f, 20.0f, 0.0f, 70.0f, addMaterial(scene, glass));
+    addQuad(scene, -20.0f, -5.0f, 8.0f, 15.0f, 60.0f,
+            addMaterial(scene, flatMaterial({0.8f, 0.7f, 0.2f, 1.0f})));
+    const dof::ThinLens lens = dof::makeThinLens(view, 10.0f, 100.0f);
+    raster::Frame pinhole;
+    raster::LayeredTarget layers;
+    dof::MultiviewScratch scratch;
+    dof::ShadingInputs shading;
+    shading.scene = &scene;
+    std::vector<float> rgba;
+    ASSERT_TRUE(dof::renderMultiview(view, lens, makeSamples(24), dof::MultiviewSettings{}, shading,
+                                     scene.background, pinholeFnOf(renderer, scene, options),
+                                     layersFnOf(renderer, scene, options), pool, rgba, &pinhole,
+                                     &layers, &scratch)
+                    .ok());
+    ASSERT_TRUE(layers.hasTransparency());
+    uint32_t partial = 0; // levels that leave rows out
+    auto check = [&](const std::vector<std::vector<std::vector<float>>>& mips,
+                     const std::vector<std::vector<uint32_t>>& row0, const raster::ColorBuffer& c,
+                     bool coverage_alpha) {
+        for (uint32_t l = 0; l < mips.size(); ++l) {
+            std::vector<float> full(size_t(view.width) * view.height * 4);
+            for (size_t i = 0; i < size_t(view.width) * view.height; ++i) {
+                glm::vec4 v = c.load(layers.index(l, i));
+                if (coverage_alpha) {
+                    const float a = v.a > 0.0f ? 1.0f : 0.0f;
+                    v = glm::vec4(glm::vec3(v) * a, a);
+                }
+                std::copy_n(&v.x, 4, full.data() + i * 4);
+            }
+            uint32_t pw = view.width, ph = view.height;
+            for (uint32_t lv = 0; lv < mips[l].size(); ++lv) {
+                const uint32_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
+                if (lv > 0) {
+                    std::vector<float> next(size_t(w) * h * 4);
+                    for (uint32_t y = 0; y < h; ++y)
+                        for (uint32_t x = 0; x < w; ++x)
+                            for (uint32_t k = 0; k < 4; ++k) {
+                                auto at = [&](uint32_t u, uint32_t v) {
+                                    return full[(size_t(std::min(v, ph - 1)) * pw +
+                                                 std::min(u, pw - 1)) *
+                                                    4 +
+                                                k];
+                                };
+                                next[(size_t(y) * w + x) * 4 + k] =
+                                    0.25f * (at(2 * x, 2 * y) + at(2 * x + 1, 2 * y) +
+                                             at(2 * x, 2 * y + 1) + at(2 * x + 1, 2 * y + 1));
+                            }
+                    full.swap(next);
+                    pw = w, ph = h;
+                }
+                std::vector<float> stored(full.size(), 0.0f);
+                ASSERT_LE(size_t(row0[l][lv]) * w * 4 + mips[l][lv].size(), stored.size());
+                std::copy(mips[l][lv].begin(), mips[l][lv].end(),
+                          stored.begin() + ptrdiff_t(size_t(row0[l][lv]) * w * 4));
+                EXPECT_EQ(hashFloats(stored), hashFloats(full)) << "layer " << l << " level " << lv;
+                partial += mips[l][lv].size() < full.size();
+            }
+        }
+    };
+    check(scratch.mips, scratch.mip_row0, layers.color, true);
+    check(scratch.transparent_mips, scratch.transparent_mip_row0, layers.transparent_color, false);
+    EXPECT_GT(partial, 0u); // the scene leaves rows of some layers empty
+}
+
 TEST(Multiview, BothRoutingPoliciesAndOffscreenPoliciesRun) {
     const raster::View view = pixelView(64, 48, 100.0f);
     raster::Scene scene = wallScene();
