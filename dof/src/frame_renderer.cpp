@@ -24,6 +24,7 @@ struct PinholeCall {
     const raster::RenderOptions& options;
     FrameReport& report;
     bool kept;
+    mutable bool depth_rendered = false; // multiview's depth-only pinhole was rendered
 };
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -134,7 +135,7 @@ raster::Status FrameRenderer::renderPinhole(const raster::Scene& scene, const ra
     addStats(report.render_sum, one);
     report.last_render = one;
     ++report.renders;
-    if (s.ok() && &out == &pinhole_ && isPinholeView(view))
+    if (s.ok() && &out == &pinhole_ && isPinholeView(view) && !options.depth_only)
         pinhole_key_ = PinholeKey{&scene, view, options};
     return s;
 }
@@ -398,13 +399,21 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
         shading.simd = options.simd;
         // The callbacks capture two pointers, which std::function stores without allocating.
         const PinholeCall call{scene, options, report, kept};
-        const PinholeFn render_pinhole = [this, &call](const raster::View& v,
-                                                       raster::Frame& f) -> Status {
+        const PinholeFn render_pinhole = [this, &call](const raster::View& v, raster::Frame& f,
+                                                       bool depth_only) -> Status {
             if (&f == &pinhole_ && call.kept && pinholeMatches(call.scene, v, call.options)) {
                 call.report.pinhole_reused = true;
                 return {};
             }
-            return renderPinhole(call.scene, v, call.options, f, call.report);
+            raster::RenderOptions o = call.options;
+            o.depth_only = depth_only;
+            // The colour after this frame's depth-only render of the same view (a skipped
+            // frame): the same geometry and bins.
+            if (!depth_only && call.depth_rendered)
+                renderer_->promiseSceneUnchanged();
+            const Status s = renderPinhole(call.scene, v, o, f, call.report);
+            call.depth_rendered = s.ok() && depth_only;
+            return s;
         };
         const LayersFn render_layers = [this, &call](const raster::View& v,
                                                      const raster::LayeredTargetDesc& d,

@@ -294,11 +294,17 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
         return st;
     raster::Frame local_pinhole;
     raster::Frame& pinhole = pinhole_out ? *pinhole_out : local_pinhole;
-    // §4.1: the pinhole through the lens centre gives the visible depth range.
+    // §4.1: the pinhole through the lens centre gives the visible depth range. Its colour is
+    // needed only by a skipped frame (rendered again below) and by a pixel whose every ray is
+    // discarded or whose weights sum to 0 (endPixel), which cannot happen when rays are clamped
+    // to the image and every sample weighs more than 0.
+    const bool positive = std::all_of(samples.samples().begin(), samples.samples().end(),
+                                      [](const LensSample& s) { return s.weight > 0.0f; });
+    const bool depth_only = settings.offscreen == OffscreenPolicy::Clamp && positive;
     auto t0 = Clock::now();
-    if (Status st = render_pinhole(view, pinhole); !st.ok())
+    if (Status st = render_pinhole(view, pinhole, depth_only); !st.ok())
         return st;
-    const double ms_pinhole = msSince(t0);
+    double ms_pinhole = msSince(t0);
     const DepthRange range = visibleDepthRange(pinhole, view);
     // Nothing to blur: the pinhole render is the result (the same rule as accum's, so both
     // methods return the pinhole image for the same lenses). Rays offset by less than half a
@@ -318,6 +324,12 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
         }
     }
     if (!skip_reason.empty()) {
+        if (depth_only) {
+            t0 = Clock::now();
+            if (Status st = render_pinhole(view, pinhole, false); !st.ok())
+                return st;
+            ms_pinhole += msSince(t0);
+        }
         rgba = pinhole.color;
         if (scratch_io)
             frameState(*scratch_io).kept = FrameState::Kept::Skipped;

@@ -35,6 +35,8 @@ struct FrameSink {
         const float stored = frame.depth.quantize(z);
         return stored < frame.depth.load(pixel) && (!peel || stored > peel->load(pixel));
     }
+    // An unshaded OPAQUE fragment (RenderOptions::depth_only): what write stores of it.
+    void writeDepth(size_t pixel, float z) { frame.depth.store(pixel, z); }
     void write(size_t pixel, const Fragment& f) {
         float* dst = &frame.color[pixel * 4];
         const glm::vec4 c =

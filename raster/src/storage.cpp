@@ -2,8 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace raster {
+
+namespace {
+bool isPositiveZero(glm::vec4 c) {
+    return c == glm::vec4(0.0f) && !std::signbit(c.r) && !std::signbit(c.g) && !std::signbit(c.b) &&
+           !std::signbit(c.a);
+}
+} // namespace
 
 void DepthBuffer::resize(DepthFormat depth_format, uint32_t w, uint32_t h) {
     format = depth_format;
@@ -52,6 +60,14 @@ void ColorBuffer::resizeUncleared(ColorFormat color_format, size_t pixels) {
 }
 
 void ColorBuffer::fill(size_t first, size_t count, glm::vec4 c) {
+    if (isPositiveZero(c)) { // +0 is all zero bits in both formats
+        if (format == ColorFormat::Float32)
+            std::memset(float32.data() + first * 4, 0, count * 4 * sizeof(float));
+        else
+            std::memset(static_cast<void*>(half.data() + first * 4), 0,
+                        count * 4 * sizeof(Imath::half));
+        return;
+    }
     if (format == ColorFormat::Float32) {
         float* p = float32.data() + first * 4;
         for (size_t i = 0; i < count; ++i, p += 4)
@@ -71,8 +87,7 @@ void ColorBuffer::resize(ColorFormat color_format, size_t pixels, glm::vec4 clea
     float32.clear();
     // resize value-initialises to +0 in both formats, so a +0 clear colour (every target's, in
     // practice) needs no store per pixel.
-    const bool zero = clear == glm::vec4(0.0f) && !std::signbit(clear.r) &&
-                      !std::signbit(clear.g) && !std::signbit(clear.b) && !std::signbit(clear.a);
+    const bool zero = isPositiveZero(clear);
     if (format == ColorFormat::Float32)
         float32.resize(pixels * 4);
     else

@@ -101,20 +101,6 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         return;
 
     const Material& m = *tr.material;
-    const bool textured = m.base_color_texture.image >= 0 || m.emissive_texture.image >= 0;
-    QuadPairUv pair_uv{};
-    if (textured) {
-        // Every lane is interpolated (helper pixels included) so each quad has coarse
-        // derivatives, one pair per quad (as GPUs' ddx/ddy).
-        for (int l = 0; l < kQuadLanes; ++l)
-            pair_uv.uv[l] = interpolateUv(tr, q, l);
-        for (int quad = 0; quad < 2; ++quad) {
-            const glm::vec2* uv = &pair_uv.uv[4 * quad];
-            pair_uv.duv_dx[quad] = uv[1] - uv[0];
-            pair_uv.duv_dy[quad] = uv[2] - uv[0];
-        }
-    }
-
     // Early depth test of every covered lane: legal because this tile's owner is the only
     // writer of the pixel. Lanes are distinct pixels and nothing is written before all are
     // tested, so testing them all first is the same as one at a time.
@@ -132,6 +118,33 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     }
     if (tested == 0)
         return;
+    if constexpr (requires(Sink & s) { s.writeDepth(size_t{}, 0.0f); }) {
+        // Depth only: every OPAQUE lane passes the alpha test (the fragment kernel keeps them
+        // all), so the lanes that passed the depth test store their depth as shaded ones would.
+        if (ctx.depth_only && m.alpha_mode == AlphaMode::Opaque) {
+            for (uint32_t rest = tested; rest != 0; rest &= rest - 1) {
+                const int l = std::countr_zero(rest);
+                const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
+                sink.writeDepth(size_t(y) * ctx.grid.width + size_t(x), q.z[l]);
+            }
+            counters.passed += uint64_t(std::popcount(tested));
+            return;
+        }
+    }
+
+    const bool textured = m.base_color_texture.image >= 0 || m.emissive_texture.image >= 0;
+    QuadPairUv pair_uv{};
+    if (textured) {
+        // Every lane is interpolated (helper pixels included) so each quad has coarse
+        // derivatives, one pair per quad (as GPUs' ddx/ddy).
+        for (int l = 0; l < kQuadLanes; ++l)
+            pair_uv.uv[l] = interpolateUv(tr, q, l);
+        for (int quad = 0; quad < 2; ++quad) {
+            const glm::vec2* uv = &pair_uv.uv[4 * quad];
+            pair_uv.duv_dx[quad] = uv[1] - uv[0];
+            pair_uv.duv_dy[quad] = uv[2] - uv[0];
+        }
+    }
 
     // The textures at the lanes that passed, together (the texture kernel).
     const bool base_textured = m.base_color_texture.image >= 0;

@@ -26,6 +26,7 @@ struct RasterContext {
     QuadKernel kernel = &quadKernelScalar;
     FragmentKernel fragment_kernel = &fragmentKernelScalar;
     bool blend_last = false; // the scene has BLEND materials: draw their triangles last
+    bool depth_only = false; // RenderOptions::depth_only (a sink with writeDepth)
 };
 
 struct TileCounters {

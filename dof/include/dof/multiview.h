@@ -363,15 +363,21 @@ raster::Status probeMultiview(const raster::View& view, const ThinLens& lens,
                               const MultiviewScratch& scratch, uint32_t x, uint32_t y,
                               MultiviewPixelProbe& out);
 
-using PinholeFn = std::function<raster::Status(const raster::View&, raster::Frame&)>;
+// Renders the pinhole view into the frame. With `depth_only` only the frame's depth buffers are
+// read (raster::RenderOptions::depth_only may serve): renderMultiview asks for the colour too
+// only when the pinhole image is, or may be, part of its output.
+using PinholeFn =
+    std::function<raster::Status(const raster::View&, raster::Frame&, bool depth_only)>;
 using LayersFn = std::function<raster::Status(const raster::View&, const raster::LayeredTargetDesc&,
                                               raster::LayeredTarget&)>;
 
 // The whole method: pinhole render (visible depth range, §4.1), layered render (§4.2), then
 // synthesizeMultiview. When the lens cannot change the image (MultiviewStats::skipped) the output
-// is the pinhole frame. `rgba` as above. `pinhole_out`, `layers_out` and `scratch` (optional)
-// are the caller's: kept from one frame to the next, their buffers are resized in place rather
-// than allocated again (the same bytes as fresh ones).
+// is the pinhole frame. The pinhole is rendered for its depth only when no pixel can take its
+// colour (OffscreenPolicy::Clamp and every lens sample of positive weight), so `pinhole_out`'s
+// colour is then not the pinhole image. `rgba` as above. `pinhole_out`, `layers_out` and `scratch`
+// (optional) are the caller's: kept from one frame to the next, their buffers are resized in place
+// rather than allocated again (the same bytes as fresh ones).
 raster::Result<MultiviewStats>
 renderMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
                 const MultiviewSettings& settings, const ShadingInputs& shading,

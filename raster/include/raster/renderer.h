@@ -42,6 +42,12 @@ struct RenderOptions {
     // depth is not strictly behind this buffer's value (same size and format as the frame's) are
     // discarded, so repeated renders peel the scene front to back.
     const DepthBuffer* peel_depth = nullptr;
+    // Renderer::render only: OPAQUE surfaces write their depth unshaded (no texture, fragment
+    // or lighting kernel), for a caller that needs the visible depths only (multiview's depth
+    // range, Lee et al. 2009 §4.1). The depth buffers are the same bits as a shaded render's;
+    // the colour is not (MASK and BLEND surfaces are still shaded, their alpha decides what they
+    // cover, but opaque surfaces leave the background).
+    bool depth_only = false;
     // Checked before the target's buffers are allocated (frameBytes, layeredTargetBytes, the
     // fragment pool: frame.h, layered_target.h); a render that does not fit fails with a Status
     // naming the sizes.

@@ -21,8 +21,10 @@ inline std::vector<float> runMultiview(const BuiltinCase& c, const dof::LensSamp
     raster::TaskPool pool(2);
     raster::Renderer renderer(pool);
     raster::RenderOptions options;
-    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f) {
-        return renderer.render(c.scene, v, options, f);
+    const dof::PinholeFn pin = [&](const raster::View& v, raster::Frame& f, bool depth_only) {
+        raster::RenderOptions o = options;
+        o.depth_only = depth_only;
+        return renderer.render(c.scene, v, o, f);
     };
     const dof::LayersFn lay = [&](const raster::View& v, const raster::LayeredTargetDesc& d,
                                   raster::LayeredTarget& t) {

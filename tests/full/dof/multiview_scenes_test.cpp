@@ -19,9 +19,14 @@
 namespace focal::test {
 namespace {
 
+// The multiview image and, when asked, the pinhole image to compare it with (rendered apart:
+// multiview's own pinhole frame holds its depth only).
 std::vector<float> multiview(const BuiltinCase& c, const dof::LensSampleSet& samples,
                              const dof::MultiviewSettings& s, raster::Frame* pinhole = nullptr) {
-    return runMultiview(c, samples, s, pinhole);
+    std::vector<float> out = runMultiview(c, samples, s);
+    if (pinhole)
+        *pinhole = render(c.scene, c.view);
+    return out;
 }
 
 dof::ErrorMetrics compare(const std::vector<float>& a, const raster::Frame& ref,

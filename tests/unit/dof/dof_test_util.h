@@ -22,8 +22,10 @@ namespace focal::test {
 // outlive them.
 inline dof::PinholeFn pinholeFnOf(raster::Renderer& renderer, const raster::Scene& scene,
                                   const raster::RenderOptions& options) {
-    return [&renderer, &scene, &options](const raster::View& v, raster::Frame& f) {
-        return renderer.render(scene, v, options, f);
+    return [&renderer, &scene, &options](const raster::View& v, raster::Frame& f, bool depth_only) {
+        raster::RenderOptions o = options;
+        o.depth_only = depth_only;
+        return renderer.render(scene, v, o, f);
     };
 }
 

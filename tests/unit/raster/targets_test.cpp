@@ -283,6 +283,34 @@ TEST(LayeredTarget, InvalidBoundsAreErrors) {
     EXPECT_FALSE(r.renderLayers(stackScene(false), stackView(), {}, d, out).ok());
 }
 
+// RenderOptions::depth_only: the depth buffers of a shaded render, bit for bit, with opaque
+// surfaces unshaded (the background where they are), on scenes with OPAQUE, MASK (foliage's
+// leaves) and BLEND (glass) surfaces, at 0 and 2 threads.
+TEST(Renderer, DepthOnlyGivesTheShadedRendersDepths) {
+    for (const char* name : {"demo", "foliage", "glass"}) {
+        raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(name);
+        ASSERT_TRUE(scene.ok()) << name;
+        const raster::View view = raster::viewFromCamera(scene->cameras[0], 96, 64);
+        for (uint32_t threads : {0u, 2u}) {
+            raster::TaskPool pool(threads);
+            raster::Renderer renderer(pool);
+            raster::RenderOptions options;
+            raster::Frame shaded, depth;
+            ASSERT_TRUE(renderer.render(*scene, view, options, shaded).ok());
+            options.depth_only = true;
+            ASSERT_TRUE(renderer.render(*scene, view, options, depth).ok());
+            EXPECT_EQ(depth.depth.float32, shaded.depth.float32) << name;
+            EXPECT_EQ(depth.transparent_depth.float32, shaded.transparent_depth.float32) << name;
+            size_t unshaded = 0; // covered pixels left at the background
+            for (size_t i = 0; i < size_t(view.width) * view.height; ++i)
+                unshaded += depth.depth.load(i) < raster::kFarDepth &&
+                            depth.color[i * 4] == scene->background.r &&
+                            shaded.color[i * 4] != scene->background.r;
+            EXPECT_GT(unshaded, 100u) << name;
+        }
+    }
+}
+
 TEST(FragmentLists, EqualDepthPeeling) {
     const raster::Scene s = stackScene(true);
     const raster::View v = stackView();
