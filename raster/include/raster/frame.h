@@ -54,15 +54,43 @@ struct VisibleDepthBounds {
     bool any = false;
 };
 inline VisibleDepthBounds visibleDepthBounds(const Frame& frame) {
+    // One buffer's extremes over its values below kFarDepth (NaN never is), on the stored
+    // values: min and max of distinct negative floats do not depend on the order, and the
+    // unorm16 decoding never decreases as the code grows (code 65535 is kFarDepth).
+    float lo = INFINITY, hi = -INFINITY;
+    bool any = false;
+    auto scan = [&](const DepthBuffer& depth) {
+        const size_t n = size_t(depth.width) * depth.height;
+        if (depth.format == DepthFormat::Float32) {
+            const float* p = depth.float32.data();
+            for (size_t i = 0; i < n; ++i)
+                if (const float d = p[i]; d < kFarDepth) {
+                    lo = d < lo ? d : lo;
+                    hi = d > hi ? d : hi;
+                    any = true;
+                }
+        } else {
+            const uint16_t* p = depth.unorm16.data();
+            uint16_t code_lo = 0xffff, code_hi = 0;
+            bool seen = false;
+            for (size_t i = 0; i < n; ++i)
+                if (const uint16_t c = p[i]; c < 0xffff) {
+                    code_lo = std::min(code_lo, c);
+                    code_hi = std::max(code_hi, c);
+                    seen = true;
+                }
+            if (seen) {
+                lo = std::min(lo, decodeUnorm16(code_lo));
+                hi = std::max(hi, decodeUnorm16(code_hi));
+                any = true;
+            }
+        }
+    };
+    scan(frame.depth);
+    scan(frame.transparent_depth);
     VisibleDepthBounds b;
-    b.min = INFINITY, b.max = -INFINITY;
-    forEachVisibleDepth(frame, [&](float d) {
-        b.min = std::min(b.min, d);
-        b.max = std::max(b.max, d);
-        b.any = true;
-    });
-    if (!b.any)
-        b.min = b.max = kFarDepth;
+    if (any)
+        b = {lo, hi, true};
     return b;
 }
 

@@ -79,14 +79,17 @@ TEST(Lens, FocusDistanceAtPixel) {
 }
 
 // visibleCocRange and visibleDepthRange take their ends from the extreme stored depths: the same
-// bits as folding every visible pixel's value (opaque and BLEND), for lenses focused in front of,
-// inside and behind the scene.
+// bits as folding every visible pixel's value (opaque and BLEND; float and, on dense, unorm16
+// depth), for lenses focused in front of, inside and behind the scene.
 TEST(Lens, VisibleRangesMatchEveryPixelsExtremes) {
     for (const char* name : {"demo", "glass", "dense"}) {
         raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(name);
         ASSERT_TRUE(scene.ok()) << name;
         const raster::View view = raster::viewFromCamera(scene->cameras[0], 96, 64);
-        const raster::Frame f = render(*scene, view);
+        raster::RenderOptions options;
+        options.depth_format = std::string_view(name) == "dense" ? raster::DepthFormat::Unorm16
+                                                                 : raster::DepthFormat::Float32;
+        const raster::Frame f = render(*scene, view, options);
         if (std::string_view(name) == "glass") { // BLEND surfaces are visible depths too
             ASSERT_GT(f.transparent_depth.bytes(), 0u);
         }
