@@ -601,9 +601,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         list.reserve(out.max_list_length);
     const uint32_t total = out.offsets[pixels];
     out.fragments_kept = total;
-    out.color.resize(desc.color_format, total, glm::vec4(0.0f));
-    out.depth.resize(desc.depth_format, total, total > 0 ? 1 : 0);
-    out.primitive.assign(total, 0);
+    // Sized without clearing: the tiles below store every one of the `total` slots.
+    out.color.resizeUncleared(desc.color_format, total);
+    out.depth.resizeUncleared(desc.depth_format, total, total > 0 ? 1 : 0);
+    out.primitive.resize(total);
     pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t) {
         const TileRect r = tileRect(st.ctx.grid, tile);
         const std::vector<FragmentNode>& kept = st.list_kept[tile];

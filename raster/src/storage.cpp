@@ -82,19 +82,8 @@ void ColorBuffer::fill(size_t first, size_t count, glm::vec4 c) {
 }
 
 void ColorBuffer::resize(ColorFormat color_format, size_t pixels, glm::vec4 clear) {
-    format = color_format;
-    half.clear();
-    float32.clear();
-    // resize value-initialises to +0 in both formats, so a +0 clear colour (every target's, in
-    // practice) needs no store per pixel.
-    const bool zero = isPositiveZero(clear);
-    if (format == ColorFormat::Float32)
-        float32.resize(pixels * 4);
-    else
-        half.resize(pixels * 4);
-    if (!zero)
-        for (size_t i = 0; i < pixels; ++i)
-            store(i, clear);
+    resizeUncleared(color_format, pixels);
+    fill(0, pixels, clear);
 }
 
 } // namespace raster
