@@ -14,17 +14,8 @@ bool isPositiveZero(glm::vec4 c) {
 } // namespace
 
 void DepthBuffer::resize(DepthFormat depth_format, uint32_t w, uint32_t h) {
-    format = depth_format;
-    width = w;
-    height = h;
-    const size_t n = size_t(w) * h;
-    if (format == DepthFormat::Float32) {
-        float32.assign(n, kFarDepth);
-        unorm16.clear();
-    } else {
-        unorm16.assign(n, encodeUnorm16(kFarDepth));
-        float32.clear();
-    }
+    resizeUncleared(depth_format, w, h);
+    fill(0, size_t(w) * h, kFarDepth);
 }
 
 void DepthBuffer::resizeUncleared(DepthFormat depth_format, uint32_t w, uint32_t h) {
