@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 
 namespace dof::multiview_detail {
@@ -23,6 +24,13 @@ constexpr double kMaxPathCells = double(1u << 22);
 // Largest image offset a ray may reach (pixels): beyond it the lens is rejected as absurd for the
 // view (offsets are then still exact in float and fit RayPath's int32 boxes).
 constexpr float kMaxReachPx = float(1u << 24);
+
+// Row y of a mipmap level that stores its rows [row0, row1), `row_floats` floats each, or
+// `zero` (a row of zeros at least as long) for a row it does not store.
+const float* storedRow(const std::vector<float>& level, size_t row0, size_t row1, size_t row_floats,
+                       size_t y, const float* zero) {
+    return y >= row0 && y < row1 ? level.data() + (y - row0) * row_floats : zero;
+}
 
 // The path of ray direction w through [s0, s1]: its cells appended to `cells`.
 RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<PathCell>& cells) {
@@ -246,58 +254,49 @@ void buildMipmaps(Tracer& tr, const LayerContent& content, float reach_max, rast
                 seg.first_cone_px = tr.r_max * std::fabs(tr.cocOf(seg.t_cone)) +
                                     1.5f * std::ldexp(1.0f, int(seg.cone_level.l1)) + 1.0f;
             }
-        // The rows each level stores: level 0 the layer's rows [row0, row1) whose texels are not
-        // +0 (every other texel of level 0 is +0), then the rows a 2x2 reduction of those can
-        // reach; a level's other rows average four +0 texels, +0 too.
-        auto planRows = [&](std::vector<uint32_t>& first, uint32_t row0, uint32_t row1) {
+        // The rows [first, end) each level stores: level 0 the layer's rows [row0, row1) whose
+        // texels are not +0 (every other texel of level 0 is +0), then the rows a 2x2 reduction
+        // of those can reach; a level's other rows average four +0 texels, +0 too.
+        using LevelRows = std::array<uint32_t, kMaxMipLevels>;
+        auto planRows = [&](std::vector<uint32_t>& first, LevelRows& end, uint32_t row0,
+                            uint32_t row1) {
             first.resize(levels);
-            uint32_t end = row1;
             for (uint32_t lv = 0; lv < levels; ++lv) {
-                if (lv > 0 && end > row0) {
+                if (lv > 0 && row1 > row0) {
                     row0 /= 2;
-                    end = std::min((end - 1) / 2 + 1, scratch.mip_height[lv]);
+                    row1 = std::min((row1 - 1) / 2 + 1, scratch.mip_height[lv]);
                 }
-                first[lv] = end > row0 ? row0 : 0;
-                if (end <= row0)
-                    row0 = end = 0;
+                if (row1 <= row0)
+                    row0 = row1 = 0;
+                first[lv] = row0;
+                end[lv] = row1;
             }
         };
         // Level 0 from `level0` (C channels per texel) on its stored rows, then 2x2 box
         // reductions; a source row a level does not store is read as zeros.
         auto build = [&]<uint32_t C>(std::vector<std::vector<float>>& mip,
-                                     const std::vector<uint32_t>& first, uint32_t row1,
+                                     const std::vector<uint32_t>& first, const LevelRows& end,
                                      auto&& level0) {
             mip.resize(levels);
-            uint32_t end = row1;
-            {
-                const uint32_t row0 = first[0];
-                end = row1 > row0 ? row1 : row0;
-                mip[0].resize(size_t(end - row0) * width * C);
-                for (size_t i = size_t(row0) * width, o = 0; i < size_t(end) * width; ++i, ++o) {
-                    const auto c = level0(i);
-                    for (uint32_t k = 0; k < C; ++k)
-                        mip[0][o * C + k] = c[k];
-                }
+            mip[0].resize(size_t(end[0] - first[0]) * width * C);
+            for (size_t i = size_t(first[0]) * width, o = 0; i < size_t(end[0]) * width; ++i, ++o) {
+                const auto c = level0(i);
+                for (uint32_t k = 0; k < C; ++k)
+                    mip[0][o * C + k] = c[k];
             }
-            uint32_t prev0 = first[0], prev1 = end;
             for (uint32_t lv = 1; lv < levels; ++lv) {
                 const uint32_t pw = scratch.mip_width[lv - 1], ph = scratch.mip_height[lv - 1];
                 const uint32_t cw = scratch.mip_width[lv];
-                const uint32_t row0 = first[lv];
-                const uint32_t row_end =
-                    prev1 > prev0 ? std::min((prev1 - 1) / 2 + 1, scratch.mip_height[lv]) : row0;
-                const std::vector<float>& src = mip[lv - 1];
                 std::vector<float>& dst = mip[lv];
-                dst.resize(size_t(row_end - row0) * cw * C);
+                dst.resize(size_t(end[lv] - first[lv]) * cw * C);
                 auto srcRow = [&](uint32_t y) {
-                    y = std::min(y, ph - 1);
-                    return y >= prev0 && y < prev1 ? src.data() + size_t(y - prev0) * pw * C
-                                                   : tr.zero_row.data();
+                    return storedRow(mip[lv - 1], first[lv - 1], end[lv - 1], size_t(pw) * C,
+                                     std::min(y, ph - 1), tr.zero_row.data());
                 };
-                for (uint32_t y = row0; y < row_end; ++y) {
+                for (uint32_t y = first[lv]; y < end[lv]; ++y) {
                     const float* r0 = srcRow(2 * y);
                     const float* r1 = srcRow(2 * y + 1);
-                    float* o = dst.data() + size_t(y - row0) * cw * C;
+                    float* o = dst.data() + size_t(y - first[lv]) * cw * C;
                     auto texel = [&](uint32_t x, uint32_t x0, uint32_t x1) {
                         for (uint32_t c = 0; c < C; ++c)
                             o[x * C + c] = 0.25f * (r0[x0 * C + c] + r0[x1 * C + c] +
@@ -309,16 +308,15 @@ void buildMipmaps(Tracer& tr, const LayerContent& content, float reach_max, rast
                     for (uint32_t x = pw / 2; x < cw; ++x)
                         texel(x, std::min(2 * x, pw - 1), std::min(2 * x + 1, pw - 1));
                 }
-                prev0 = row0;
-                prev1 = row_end;
             }
         };
         pool.parallelFor(m, [&](uint32_t l, uint32_t) {
             if (tr.segs[l].empty)
                 return;
-            planRows(scratch.mip_row0[l], content.row0[l], content.row1[l]);
+            LevelRows end;
+            planRows(scratch.mip_row0[l], end, content.row0[l], content.row1[l]);
             const std::vector<uint32_t>& first = scratch.mip_row0[l];
-            build.template operator()<4>(scratch.mips[l], first, content.row1[l], [&](size_t i) {
+            build.template operator()<4>(scratch.mips[l], first, end, [&](size_t i) {
                 // coverage alpha: 1 where covered
                 const glm::vec4 c = layers.color.load(layers.index(l, i));
                 const float a = c.a > 0.0f ? 1.0f : 0.0f;
@@ -328,7 +326,7 @@ void buildMipmaps(Tracer& tr, const LayerContent& content, float reach_max, rast
                 const float lo = tr.segs[l].own0, hi = tr.segs[l].own1;
                 const bool last = l + 1 == m;
                 build.template operator()<kOwnedChannels>(
-                    scratch.owned_mips[l], first, content.row1[l], [&](size_t i) {
+                    scratch.owned_mips[l], first, end, [&](size_t i) {
                         const float d = scratch.depth[l][i];
                         const bool owned = d >= lo && (d < hi || (last && d <= hi));
                         const glm::vec4 c = layers.color.load(layers.index(l, i));
@@ -342,12 +340,9 @@ void buildMipmaps(Tracer& tr, const LayerContent& content, float reach_max, rast
                     // Rows the level does not store have no coverage.
                     const uint32_t lv = tr.segs[l].cone_last_level;
                     const size_t w = scratch.mip_width[lv], h = scratch.mip_height[lv];
-                    const size_t row0 = first[lv];
-                    const size_t rows = scratch.owned_mips[l][lv].size() / (w * kOwnedChannels);
                     auto coverage = [&](size_t v) {
-                        return (v >= row0 && v < row0 + rows ? scratch.owned_mips[l][lv].data() +
-                                                                   (v - row0) * w * kOwnedChannels
-                                                             : tr.zero_row.data()) +
+                        return storedRow(scratch.owned_mips[l][lv], first[lv], end[lv],
+                                         w * kOwnedChannels, v, tr.zero_row.data()) +
                                1;
                     };
                     blocks.assign(w * h, 0);
@@ -363,11 +358,11 @@ void buildMipmaps(Tracer& tr, const LayerContent& content, float reach_max, rast
                 }
             }
             if (transparency) { // already premultiplied, alpha = opacity
-                planRows(scratch.transparent_mip_row0[l], content.transparent_row0[l],
-                         content.transparent_row1[l]);
+                LevelRows transparent_end;
+                planRows(scratch.transparent_mip_row0[l], transparent_end,
+                         content.transparent_row0[l], content.transparent_row1[l]);
                 build.template operator()<4>(
-                    scratch.transparent_mips[l], scratch.transparent_mip_row0[l],
-                    content.transparent_row1[l],
+                    scratch.transparent_mips[l], scratch.transparent_mip_row0[l], transparent_end,
                     [&](size_t i) { return layers.transparent_color.load(layers.index(l, i)); });
             }
         });

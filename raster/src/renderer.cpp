@@ -159,7 +159,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.kernel = selectQuadKernel(options.simd);
     st.ctx.fragment_kernel = selectFragmentKernel(options.simd);
     st.ctx.blend_last = hasBlendMaterial(scene);
-    st.ctx.depth_only = false; // render() sets it
+    st.ctx.depth_only = options.depth_only; // only FrameSink (render) has writeDepth
     prepareLights(scene, defaultLightDirection(view), st.lights);
     st.ctx.shade.lights = st.lights.data();
     st.ctx.shade.light_count = uint32_t(st.lights.size());
@@ -248,7 +248,6 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
     if (Status s = prepare(scene, view, options, unchanged, stats); !s.ok())
         return s;
     State& st = *state_;
-    st.ctx.depth_only = options.depth_only;
     out.width = view.width;
     out.height = view.height;
     const size_t pixels = size_t(view.width) * view.height;
