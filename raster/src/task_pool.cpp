@@ -12,6 +12,7 @@ constexpr auto kSpin = std::chrono::microseconds(200);
 
 TaskPool::TaskPool(uint32_t threads) : thread_count_(threads) {
     worker_count_ = threads == 0 ? 1 : threads;
+    shares_ = std::make_unique<Share[]>(worker_count_);
     // More threads than cores: a spinning thread would take the core a working one needs.
     const unsigned cores = std::thread::hardware_concurrency();
     spin_ = cores == 0 || worker_count_ <= cores ? kSpin : std::chrono::microseconds(0);
@@ -51,21 +52,52 @@ template <class Done> bool spinUntil(std::chrono::microseconds spin, Done&& done
 
 } // namespace
 
-void TaskPool::drain(uint32_t worker) {
+namespace {
+
+constexpr uint64_t kBackOne = uint64_t{1} << 32;
+
+uint64_t packRange(uint32_t front, uint32_t back) {
+    return uint64_t{back} << 32 | front;
+}
+
+// Takes the front (owner) or back (thief) index of a share; false when it is empty.
+template <bool kFront> bool take(std::atomic<uint64_t>& range, uint32_t& index) {
+    uint64_t r = range.load(std::memory_order_relaxed);
     for (;;) {
-        const uint32_t index = next_.fetch_add(1, std::memory_order_relaxed);
-        if (index >= job_count_)
-            return;
-        try {
-            (*job_)(index, worker);
-        } catch (...) {
-            // Stop handing out work; the caller rethrows the first failure.
-            next_.store(job_count_, std::memory_order_relaxed);
-            std::lock_guard<std::mutex> lock(mutex_);
-            if (!failure_)
-                failure_ = std::current_exception();
-            return;
+        const uint32_t front = uint32_t(r), back = uint32_t(r >> 32);
+        if (front >= back)
+            return false;
+        if (range.compare_exchange_weak(r, kFront ? r + 1 : r - kBackOne,
+                                        std::memory_order_relaxed)) {
+            index = kFront ? front : back - 1;
+            return true;
         }
+    }
+}
+
+} // namespace
+
+void TaskPool::run(uint32_t index, uint32_t worker) {
+    try {
+        (*job_)(index, worker);
+    } catch (...) {
+        // Stop handing out work; the caller rethrows the first failure.
+        for (uint32_t w = 0; w < worker_count_; ++w)
+            shares_[w].range.store(0, std::memory_order_relaxed);
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!failure_)
+            failure_ = std::current_exception();
+    }
+}
+
+void TaskPool::drain(uint32_t worker) {
+    uint32_t index = 0;
+    while (take<true>(shares_[worker].range, index))
+        run(index, worker);
+    for (uint32_t i = 1; i < worker_count_; ++i) {
+        std::atomic<uint64_t>& victim = shares_[(worker + i) % worker_count_].range;
+        while (take<false>(victim, index))
+            run(index, worker);
     }
 }
 
@@ -101,8 +133,10 @@ void TaskPool::parallelFor(uint32_t count, TaskFn fn) {
     }
     bool wake = false;
     job_ = &fn;
-    job_count_ = count;
-    next_.store(0, std::memory_order_relaxed);
+    for (uint32_t w = 0; w < worker_count_; ++w)
+        shares_[w].range.store(packRange(uint32_t(uint64_t(count) * w / worker_count_),
+                                         uint32_t(uint64_t(count) * (w + 1) / worker_count_)),
+                               std::memory_order_relaxed);
     busy_.store(uint32_t(threads_.size()), std::memory_order_relaxed);
     {
         // Published under the lock, so a worker that is about to sleep sees it in its wait.

@@ -1,7 +1,15 @@
 // TaskPool: a fixed set of std::thread workers, created by the caller and passed down (no
-// globals). parallelFor hands out indices from one atomic counter; which worker runs which index
-// is not deterministic, so callers write each result to a slot owned by its index.
-// threads == 0 runs everything inline on the calling thread.
+// globals). parallelFor splits the indices into one contiguous share per worker; a worker takes
+// its own share from the front and then the others' from their backs (work stealing). Which
+// worker runs which index is not deterministic, so callers write each result to a slot owned by
+// its index. threads == 0 runs everything inline on the calling thread.
+//
+// Why shares rather than one counter for all: a frame's buffers are written tile by tile, frame
+// after frame (and accum's views into the same frame). With one counter a tile went to either
+// worker at random, so about half of every frame's stores hit lines the other core wrote last
+// and had to fetch them from it; with shares a worker gets mostly the tiles it had in the last
+// frame. Stealing from the back keeps the balance of one counter: a worker idles only when no
+// index is left anywhere.
 //
 // A frame makes tens of parallelFor calls with a little serial work between them. Waking a
 // sleeping thread through the kernel costs tens of microseconds (more in a virtual machine), and
@@ -62,8 +70,15 @@ public:
     void parallelFor(uint32_t count, TaskFn fn);
 
 private:
+    // One worker's share of the job's indices, [front, back) packed in one word (back in the
+    // high half) so that its owner (front) and thieves (back) never take the same index.
+    struct alignas(64) Share {
+        std::atomic<uint64_t> range{0};
+    };
+
     void workerLoop(uint32_t worker);
     void drain(uint32_t worker);
+    void run(uint32_t index, uint32_t worker);
 
     uint32_t thread_count_ = 0;
     uint32_t worker_count_ = 1;
@@ -75,14 +90,13 @@ private:
     // The job, written by parallelFor before it publishes a new generation (release) and read
     // by the workers after they see it (acquire).
     const TaskFn* job_ = nullptr;
-    uint32_t job_count_ = 0;
     std::atomic<uint64_t> generation_{0}; // incremented (under mutex_) per job and at shutdown
     std::atomic<uint32_t> busy_{0};       // threads still draining the current job
     std::atomic<bool> stop_{false};
-    std::atomic<uint32_t> next_{0};
-    uint32_t sleeping_ = 0;       // threads waiting on wake_ (guarded by mutex_)
-    bool caller_waiting_ = false; // the caller waits on done_ (guarded by mutex_)
-    std::exception_ptr failure_;  // the first exception fn threw (guarded by mutex_)
+    std::unique_ptr<Share[]> shares_; // worker_count_ entries
+    uint32_t sleeping_ = 0;           // threads waiting on wake_ (guarded by mutex_)
+    bool caller_waiting_ = false;     // the caller waits on done_ (guarded by mutex_)
+    std::exception_ptr failure_;      // the first exception fn threw (guarded by mutex_)
 };
 
 } // namespace raster

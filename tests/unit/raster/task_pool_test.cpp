@@ -21,6 +21,46 @@ TEST(TaskPool, RunsEveryIndexOnceForAnyThreadCount) {
     }
 }
 
+// Counts below, at and above the worker count: the shares (some empty) cover every index once.
+TEST(TaskPool, SharesCoverEveryIndexOnceForAnyCount) {
+    for (const uint32_t threads : {2u, 3u, 5u, 8u})
+        for (const uint32_t count : {1u, 2u, 3u, 4u, 7u, 8u, 9u, 63u, 130u}) {
+            raster::TaskPool pool(threads);
+            std::vector<std::atomic<int>> hits(count);
+            pool.parallelFor(count, [&](uint32_t i, uint32_t) { hits[i].fetch_add(1); });
+            for (uint32_t i = 0; i < count; ++i)
+                EXPECT_EQ(hits[i].load(), 1)
+                    << "threads " << threads << ", count " << count << ", index " << i;
+        }
+}
+
+// A worker stalled in its first index: the others take the rest of its share (from its back),
+// so the job finishes. Without stealing the stalled worker's share would wait for it, and the
+// stall, which waits for every other index, would end only at its timeout.
+TEST(TaskPool, OtherWorkersFinishAStalledWorkersShare) {
+    constexpr uint32_t kCount = 60;
+    raster::TaskPool pool(3);
+    std::vector<std::atomic<int>> hits(kCount);
+    std::atomic<uint32_t> done{0};
+    std::atomic<bool> timed_out{false};
+    std::atomic<bool> stalled{false};
+    pool.parallelFor(kCount, [&](uint32_t i, uint32_t worker) {
+        if (worker == 1 && !stalled.exchange(true)) {
+            const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+            while (done.load() < kCount - 1)
+                if (std::chrono::steady_clock::now() > until) {
+                    timed_out = true;
+                    break;
+                }
+        }
+        hits[i].fetch_add(1);
+        done.fetch_add(1);
+    });
+    EXPECT_FALSE(timed_out.load());
+    for (uint32_t i = 0; i < kCount; ++i)
+        EXPECT_EQ(hits[i].load(), 1) << "index " << i;
+}
+
 // Calls back to back (the workers still spinning) and after pauses longer than the spin (the
 // workers asleep on the condition variable): every call runs each index once, and returns only
 // when all are done.
