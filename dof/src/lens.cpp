@@ -19,12 +19,6 @@ ThinLens makeThinLens(const raster::View& view, float aperture_radius, float foc
     return lens;
 }
 
-float cocRadiusPx(const ThinLens& lens, float depth) {
-    // Lee et al. 2009 Eq. 3 in pixels: C(d) = E f_px (1/d_f - 1/d); 1/inf = 0 gives C(inf).
-    const float inv_d = std::isinf(depth) ? 0.0f : 1.0f / depth;
-    return lens.aperture_radius * lens.focal_length_px * (1.0f / lens.focus_distance - inv_d);
-}
-
 glm::vec2 lensRayImageOffset(float coc_radius_px, glm::vec2 v) {
     // Camera y is up, pixel rows grow downwards: only x changes sign (docs/dof/lens.md, "Lens
     // samples and the sign convention").

@@ -59,12 +59,6 @@ float depthFromDistance(const View& view, float d) {
     return -view.znear / d;
 }
 
-float distanceFromDepth(const View& view, float stored_depth) {
-    const float inv_far = view.zfar > 0.0f ? 1.0f / view.zfar : 0.0f;
-    const float inv_d = inv_far - stored_depth * (1.0f / view.znear - inv_far);
-    return inv_d > 0.0f ? 1.0f / inv_d : INFINITY;
-}
-
 namespace {
 // Floats (no NaN) as integers in the same order; -0 and +0 share a key.
 int32_t orderedKey(float v) {

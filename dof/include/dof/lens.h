@@ -30,6 +30,7 @@
 
 #include <glm/vec2.hpp>
 
+#include <cmath>
 #include <cstdint>
 
 namespace dof {
@@ -45,8 +46,12 @@ struct ThinLens {
 // The lens for `view` (f_px from its yfov and height).
 ThinLens makeThinLens(const raster::View& view, float aperture_radius, float focus_distance);
 
-// Signed circle-of-confusion radius in pixels, C(d) = E*f_px*(1/d_f - 1/d); C(inf) = E*f_px/d_f.
-float cocRadiusPx(const ThinLens& lens, float depth);
+// Signed circle-of-confusion radius in pixels, C(d) = E*f_px*(1/d_f - 1/d); C(inf) = E*f_px/d_f
+// (Lee et al. 2009 Eq. 3 in pixels). Inline: multilayer calls it per slice and per fragment.
+inline float cocRadiusPx(const ThinLens& lens, float depth) {
+    const float inv_d = std::isinf(depth) ? 0.0f : 1.0f / depth;
+    return lens.aperture_radius * lens.focal_length_px * (1.0f / lens.focus_distance - inv_d);
+}
 
 // Where the lens ray through a pixel, from lens sample v, meets depth d, relative to that
 // pixel in the pinhole image (pixels, x right, y down): C(d) * (-v.x, v.y).

@@ -17,6 +17,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include <cmath>
 #include <cstdint>
 
 namespace raster {
@@ -51,9 +52,14 @@ glm::mat4 viewMatrix(const View& view);
 // Camera -> clip space: the off-axis frustum described above, z_clip/w_clip = D (see top).
 glm::mat4 projectionMatrix(const View& view);
 
-// Stored depth D <-> distance d along the view axis.
+// Stored depth D <-> distance d along the view axis. distanceFromDepth is inline: the
+// fragment-list collection and resolve and multilayer's levels call it per fragment.
 float depthFromDistance(const View& view, float d);
-float distanceFromDepth(const View& view, float stored_depth);
+inline float distanceFromDepth(const View& view, float stored_depth) {
+    const float inv_far = view.zfar > 0.0f ? 1.0f / view.zfar : 0.0f;
+    const float inv_d = inv_far - stored_depth * (1.0f / view.znear - inv_far);
+    return inv_d > 0.0f ? 1.0f / inv_d : INFINITY;
+}
 // The smallest stored depth D with distanceFromDepth(view, D) >= d, or 1 (the cleared value)
 // when no D below 1 reaches d. distanceFromDepth never decreases as D grows (each of its
 // rounded steps is monotone), so for every stored D < 1 the test distanceFromDepth(view, D) >= d
