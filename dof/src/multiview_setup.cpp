@@ -49,6 +49,19 @@ RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<
     return p;
 }
 
+// A texel's coverage (alpha > 0) and whether any channel holds other bits than the clear
+// value +0, from the stored bits of a colour buffer of float (Bits = uint32_t) or half
+// (uint16_t) values: a half widens to a float of the same sign, zero-ness and NaN-ness, so
+// these are the answers of loading the texel as floats, without converting four values.
+// `kInf`: the bits of +inf; a value is > 0 iff its bits lie in [1, kInf] (NaNs lie above).
+template <class Bits, Bits kInf> struct TexelBits {
+    bool covered, drawn;
+    TexelBits(Bits r, Bits g, Bits b, Bits a)
+        : covered(Bits(a - 1) < kInf), drawn((r | g | b | a) != 0) {}
+};
+using FloatTexelBits = TexelBits<uint32_t, 0x7f800000u>;
+using HalfTexelBits = TexelBits<uint16_t, 0x7c00u>;
+
 } // namespace
 
 void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool,
@@ -72,22 +85,22 @@ void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool
     pool.parallelFor(m, [&](uint32_t l, uint32_t) {
         float lo = INFINITY, hi = -INFINITY;
         // Returns whether any texel is covered; [row0, row1): the rows with a texel not +0.
-        auto copy = [&](const raster::ColorBuffer& color, const raster::DepthBuffer& depth,
-                        std::vector<float>& d, uint32_t& row0, uint32_t& row1) {
+        // bits(k): the bits of the colour buffer's value k.
+        auto copyAs = [&]<class Texel>(auto bits, const raster::DepthBuffer& depth,
+                                       std::vector<float>& d, uint32_t& row0, uint32_t& row1) {
             d.resize(pixels);
             bool any = false;
             for (uint32_t y = 0; y < height; ++y) {
                 bool drawn = false;
                 for (size_t i = size_t(y) * width, end = i + width; i < end; ++i) {
                     const size_t li = layers.index(l, i);
-                    const glm::vec4 c = color.load(li);
-                    const bool covered = c.a > 0.0f;
-                    const float v = covered ? depth.load(li) : kEmptyDepth;
+                    const Texel t(bits(4 * li), bits(4 * li + 1), bits(4 * li + 2),
+                                  bits(4 * li + 3));
+                    const float v = t.covered ? depth.load(li) : kEmptyDepth;
                     d[i] = v;
                     // Not the clear value +0: the mipmaps' level 0 may differ from +0 here.
-                    drawn |= (std::bit_cast<uint32_t>(c.r) | std::bit_cast<uint32_t>(c.g) |
-                              std::bit_cast<uint32_t>(c.b) | std::bit_cast<uint32_t>(c.a)) != 0;
-                    if (covered) {
+                    drawn |= t.drawn;
+                    if (t.covered) {
                         lo = std::min(lo, v);
                         hi = std::max(hi, v);
                         any = true;
@@ -99,6 +112,15 @@ void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool
                 }
             }
             return any;
+        };
+        auto copy = [&](const raster::ColorBuffer& color, const raster::DepthBuffer& depth,
+                        std::vector<float>& d, uint32_t& row0, uint32_t& row1) {
+            if (color.format == raster::ColorFormat::Half)
+                return copyAs.template operator()<HalfTexelBits>(
+                    [&](size_t k) { return color.half[k].bits(); }, depth, d, row0, row1);
+            return copyAs.template operator()<FloatTexelBits>(
+                [&](size_t k) { return std::bit_cast<uint32_t>(color.float32[k]); }, depth, d, row0,
+                row1);
         };
         copy(layers.color, layers.depth, scratch.depth[l], content.row0[l], content.row1[l]);
         if (transparency)

@@ -43,9 +43,9 @@ std::string aperture(const char* file) {
 
 // Every method, each with the choices its paper made and with focal's defaults, on scenes that
 // exercise it: accum with and without pixel jitter, gather with 32- and 16-bit depth, the
-// layered methods on near-field blur (railing), transparency (glass) and shiny surfaces
-// (reflective), and the three aperture shapes on the bokeh scene. Lens samples are kept low
-// (16): the goldens pin bytes, not quality.
+// layered methods on near-field blur (railing), transparency (glass, with half and float
+// layers) and shiny surfaces (reflective), and the three aperture shapes on the bokeh scene.
+// Lens samples are kept low (16): the goldens pin bytes, not quality.
 std::vector<DofCase> dofCases() {
     const std::vector<std::string> mv = {"--method", "multiview", "--samples", "16"};
     const std::vector<std::string> ml = {"--method", "multilayer"};
@@ -83,6 +83,7 @@ std::vector<DofCase> dofCases() {
         {"multiview_railing", "builtin:railing", mv},
         {"multiview_railing_paper", "builtin:railing", join(mv, mv_paper)},
         {"multiview_glass", "builtin:glass", mv},
+        {"multiview_glass_precision32", "builtin:glass", join(mv, {"--precision", "32"})},
         {"multiview_reflective_view_dependent", "builtin:reflective",
          join(mv, {"--view-dependent"})},
         {"multilayer_demo", "builtin:demo", ml},
@@ -108,6 +109,7 @@ constexpr std::pair<const char*, const char*> kMustDiffer[] = {
     {"multiview_railing", "multiview_railing_paper"},
     {"multilayer_demo", "multilayer_demo_paper"},
     {"multilayer_railing", "multilayer_railing_paper"},
+    {"multiview_glass", "multiview_glass_precision32"},
     {"accum_bokeh", "accum_bokeh_polygon"},
     {"accum_bokeh", "accum_bokeh_star"},
     {"accum_bokeh_polygon", "accum_bokeh_star"},
