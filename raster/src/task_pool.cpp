@@ -50,10 +50,6 @@ template <class Done> bool spinUntil(std::chrono::microseconds spin, Done&& done
     }
 }
 
-} // namespace
-
-namespace {
-
 constexpr uint64_t kBackOne = uint64_t{1} << 32;
 
 uint64_t packRange(uint32_t front, uint32_t back) {
