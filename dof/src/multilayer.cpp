@@ -194,10 +194,10 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
     for (uint32_t si = 0; si < segments.size(); ++si) {
         if (ca >= kOpaque)
             break;
-        const LevelBorders::Segment& seg = segments[si];
-        const uint32_t side = tf.sideOf(seg);
+        const uint32_t side = st.seg_side[si];
         if ((present[side] & st.seg_levels[si]) == 0)
             continue; // nothing to read in this segment
+        const LevelBorders::Segment& seg = segments[si];
         Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
         const uint32_t* count_side = cursor_count[side];
         const uint32_t lv[2] = {seg.lo, seg.hi};
@@ -651,15 +651,18 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     } else {
         out.level_rgba.clear();
     }
-    // Per segment of T: the last depth a slice may reach (below its end), and the levels it
-    // reads as a bit mask.
+    // Per segment of T: the last depth a slice may reach (below its end), the levels it reads
+    // as a bit mask, and the side whose levels those are (looked up, not recomputed, per pixel).
     std::vector<float>& seg_last = trav.seg_last;
     std::vector<uint64_t>& seg_levels = trav.seg_levels;
+    std::vector<uint8_t>& seg_side = trav.seg_side;
     seg_last.resize(segments.size());
     seg_levels.resize(segments.size());
+    seg_side.resize(segments.size());
     for (size_t i = 0; i < segments.size(); ++i) {
         seg_last[i] = std::nextafter(segments[i].end, 0.0f);
         seg_levels[i] = (uint64_t{1} << segments[i].lo) | (uint64_t{1} << segments[i].hi);
+        seg_side[i] = uint8_t(tf.sideOf(segments[i]));
     }
     static_assert(kMaxTraversalLevels <= 64);
     std::vector<uint64_t>& row_slices = row_slices_;
