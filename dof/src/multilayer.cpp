@@ -634,15 +634,9 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     t0 = std::chrono::steady_clock::now();
     out.width = width;
     out.height = height;
-    // Cleared row by row on the pool (one thread clearing the image was serial time): the
-    // slices add to +0; pixels whose base list is empty keep depth +inf.
+    // Not cleared: the traversal below writes every pixel's colour and depth.
     out.rgba.resize(size_t(width) * height * 4);
     out.depth.resize(size_t(width) * height);
-    pool.parallelFor(height, [&](uint32_t y, uint32_t) {
-        std::fill_n(out.rgba.data() + size_t(y) * width * 4, size_t(width) * 4, 0.0f);
-        std::fill_n(out.depth.data() + size_t(y) * width, width,
-                    std::numeric_limits<float>::infinity());
-    });
     const bool contributions = settings.level_contributions;
     if (contributions) {
         out.level_rgba.resize(n + 2);
@@ -678,10 +672,10 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
         for (uint32_t x = 0; x < width; ++x) {
             const size_t p = size_t(y) * width + x;
             {
+                // The closest collected fragment's depth; +inf where the base list is empty.
                 uint32_t count = 0;
                 const LayerFragment* base = levels_[0].list(x, y, count);
-                if (count > 0)
-                    out.depth[p] = base[0].depth;
+                out.depth[p] = count > 0 ? base[0].depth : std::numeric_limits<float>::infinity();
             }
             slices += traversePixel(tf, rows, cursors, x, out.rgba.data() + 4 * p,
                                     contributions ? &out.level_rgba : nullptr, p, none);

@@ -228,7 +228,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         // texel: lens-centre shading and no ray dropped at the image border.
         tr.in_focus = !shade && settings.offscreen == OffscreenPolicy::Clamp;
     }
-    rgba.assign(pixels * 4, 0.0f);
+    // Not cleared (a serial pass over the image): traceTile writes every pixel of every tile.
+    rgba.resize(pixels * 4);
     const uint32_t ts = settings.tile_size;
     const uint32_t tiles_x = (width + ts - 1) / ts, tiles_y = (height + ts - 1) / ts;
     std::vector<TileCounters>& counters = fs.counters;
