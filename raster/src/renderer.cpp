@@ -31,8 +31,11 @@ struct Renderer::State {
     std::vector<std::vector<FragmentNode>> sort_scratch;
     // Per tile: its lists as the resolve keeps them, until they are copied into place.
     std::vector<std::vector<FragmentNode>> list_kept;
-    // ListSink early rejection: per worker, the k nearest depths of each pixel of its tile.
+    // ListSink early rejection: per worker, the k nearest keys of each pixel of its tile and
+    // how many of them are in use.
     std::vector<std::vector<float>> list_nearest;
+    std::vector<std::vector<uint8_t>> list_nearest_used;
+    static_assert(kMaxEarlyRejectCap <= 255, "ListSink counts a pixel's keys in a uint8_t");
     // The resolve's counts per tile: the longest list appended and the fragments hidden.
     std::vector<uint32_t> list_longest;
     std::vector<uint64_t> list_hidden;
@@ -454,10 +457,13 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     // Every worker's early-rejection keys are sized here, not by the first tile it happens to
     // take: which worker takes which tile varies, and a second identical frame allocates nothing.
     st.list_nearest.resize(pool_.workerCount());
-    const size_t nearest_size =
-        size_t(st.ctx.grid.tile_size) * st.ctx.grid.tile_size * size_t(early_k);
+    st.list_nearest_used.resize(pool_.workerCount());
+    const size_t tile_pixels = size_t(st.ctx.grid.tile_size) * st.ctx.grid.tile_size;
+    const size_t nearest_size = tile_pixels * size_t(early_k);
     for (std::vector<float>& nearest : st.list_nearest)
         nearest.reserve(nearest_size);
+    for (std::vector<uint8_t>& used : st.list_nearest_used)
+        used.reserve(tile_pixels);
 
     // Collection: every fragment, in primitive order, into its tile's pool.
     auto t0 = std::chrono::steady_clock::now();
@@ -470,9 +476,13 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         ListSink sink{st.list_head, nodes};
         if (early_k > 0) {
             const TileRect r = tileRect(st.ctx.grid, tile);
+            // Only the counts are cleared: a pixel's keys beyond its count are never read.
             std::vector<float>& nearest = st.list_nearest[worker];
-            nearest.assign(nearest_size, INFINITY);
+            std::vector<uint8_t>& used = st.list_nearest_used[worker];
+            nearest.resize(nearest_size);
+            used.assign(tile_pixels, 0);
             sink.nearest = nearest.data();
+            sink.used = used.data();
             sink.k = early_k;
             sink.cap = desc.max_per_pixel;
             sink.hidden_scale = hidden_scale;

@@ -140,9 +140,11 @@ constexpr uint32_t kNoNode = 0xffffffffu;
 struct ListSink {
     std::vector<uint32_t>& head;     // per pixel: first node (tile-local index) or kNoNode
     std::vector<FragmentNode>& pool; // this tile's nodes
-    // Per pixel of the tile (row-major, tile_size wide), k ascending keys (+inf = none yet);
-    // null when early rejection is off.
+    // Per pixel of the tile (row-major, tile_size wide), k key slots, the first used[] of them
+    // in use, in ascending order (the slots behind are unused, as +inf keys would be); null
+    // when early rejection is off.
     float* nearest = nullptr;
+    uint8_t* used = nullptr;
     uint32_t k = 0;
     uint32_t cap = 0;           // N
     float hidden_scale = 0.0f;  // 1 + ε with hidden fragments, else 0 (the keys are depths)
@@ -150,22 +152,25 @@ struct ListSink {
     uint32_t frame_width = 0, tile_x0 = 0, tile_y0 = 0, tile_size = 0;
     static constexpr bool wants_gbuffer = false;
 
-    float* nearestOf(size_t pixel) const {
+    // The pixel's index in the tile (nearest holds k keys, used one count per index).
+    size_t tilePixel(size_t pixel) const {
         const size_t x = pixel % frame_width, y = pixel / frame_width;
-        return nearest + ((y - tile_y0) * tile_size + (x - tile_x0)) * k;
+        return (y - tile_y0) * tile_size + (x - tile_x0);
     }
     float keyOf(float z) const { return hidden_scale > 0.0f ? distanceFromDepth(*view, z) : z; }
     void beginTriangle(const SetupTri&, bool) {}
     bool test(size_t pixel, float z, float) const {
         if (!nearest)
             return true;
-        const float* keys = nearestOf(pixel);
+        const size_t t = tilePixel(pixel);
+        const float* keys = nearest + t * k;
+        const uint32_t n = used[t];
         if (!(hidden_scale > 0.0f))
-            return !(z > keys[k - 1]);
+            return n < k || !(z > keys[k - 1]);
         const float d = keyOf(z);
         uint32_t spaced = 0;
         float last = 0.0f;
-        for (uint32_t i = 0; i < k && keys[i] < d; ++i)
+        for (uint32_t i = 0; i < n && keys[i] < d; ++i)
             if (spaced == 0 || keys[i] > last * hidden_scale) {
                 last = keys[i];
                 if (++spaced == cap)
@@ -176,14 +181,19 @@ struct ListSink {
     void write(size_t pixel, const Fragment& f) {
         pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
         head[pixel] = uint32_t(pool.size() - 1);
-        if (nearest) { // insert the key into the pixel's ascending k keys, dropping the largest
-            float* d = nearestOf(pixel);
+        if (nearest) { // insert the key into the pixel's ascending keys, the largest of k + 1
+                       // dropped
+            const size_t t = tilePixel(pixel);
+            float* d = nearest + t * k;
+            const uint32_t n = used[t];
             const float key = keyOf(f.z);
-            if (key < d[k - 1]) { // else not among the k nearest
-                uint32_t i = k - 1;
+            // An unused slot counts as +inf: a +inf or NaN key is never stored.
+            if (key < (n < k ? INFINITY : d[k - 1])) {
+                uint32_t i = n < k ? n : k - 1; // shift only the keys in use
                 for (; i > 0 && d[i - 1] > key; --i)
                     d[i] = d[i - 1];
                 d[i] = key;
+                used[t] = uint8_t(n < k ? n + 1 : k);
             }
         }
     }
