@@ -181,8 +181,8 @@ struct ListSink {
     void write(size_t pixel, const Fragment& f) {
         pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
         head[pixel] = uint32_t(pool.size() - 1);
-        if (nearest) { // insert the key into the pixel's ascending keys, the largest of k + 1
-                       // dropped
+        // Early rejection: the key joins the pixel's ascending keys (of k + 1, the largest goes).
+        if (nearest) {
             const size_t t = tilePixel(pixel);
             float* d = nearest + t * k;
             const uint32_t n = used[t];
