@@ -53,14 +53,15 @@ RayPath walkPath(const Tracer& tr, glm::vec2 w, float s0, float s1, std::vector<
 // value +0, from the stored bits of a colour buffer of float (Bits = uint32_t) or half
 // (uint16_t) values: a half widens to a float of the same sign, zero-ness and NaN-ness, so
 // these are the answers of loading the texel as floats, without converting four values.
-// `kInf`: the bits of +inf; a value is > 0 iff its bits lie in [1, kInf] (NaNs lie above).
-template <class Bits, Bits kInf> struct TexelBits {
+// A value is > 0 iff its bits lie in [1, bits of +inf] (NaNs lie above).
+struct TexelBits {
     bool covered, drawn;
-    TexelBits(Bits r, Bits g, Bits b, Bits a)
-        : covered(Bits(a - 1) < kInf), drawn((r | g | b | a) != 0) {}
 };
-using FloatTexelBits = TexelBits<uint32_t, 0x7f800000u>;
-using HalfTexelBits = TexelBits<uint16_t, 0x7c00u>;
+template <class Bits> TexelBits texelBits(Bits r, Bits g, Bits b, Bits a) {
+    static_assert(sizeof(Bits) == 2 || sizeof(Bits) == 4);
+    constexpr Bits kInf = sizeof(Bits) == 2 ? Bits(0x7c00u) : Bits(0x7f800000u);
+    return {Bits(a - 1) < kInf, (r | g | b | a) != 0};
+}
 
 } // namespace
 
@@ -86,16 +87,16 @@ void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool
         float lo = INFINITY, hi = -INFINITY;
         // Returns whether any texel is covered; [row0, row1): the rows with a texel not +0.
         // bits(k): the bits of the colour buffer's value k.
-        auto copyAs = [&]<class Texel>(auto bits, const raster::DepthBuffer& depth,
-                                       std::vector<float>& d, uint32_t& row0, uint32_t& row1) {
+        auto copyAs = [&](auto bits, const raster::DepthBuffer& depth, std::vector<float>& d,
+                          uint32_t& row0, uint32_t& row1) {
             d.resize(pixels);
             bool any = false;
             for (uint32_t y = 0; y < height; ++y) {
                 bool drawn = false;
                 for (size_t i = size_t(y) * width, end = i + width; i < end; ++i) {
                     const size_t li = layers.index(l, i);
-                    const Texel t(bits(4 * li), bits(4 * li + 1), bits(4 * li + 2),
-                                  bits(4 * li + 3));
+                    const TexelBits t = texelBits(bits(4 * li), bits(4 * li + 1), bits(4 * li + 2),
+                                                  bits(4 * li + 3));
                     const float v = t.covered ? depth.load(li) : kEmptyDepth;
                     d[i] = v;
                     // Not the clear value +0: the mipmaps' level 0 may differ from +0 here.
@@ -116,11 +117,9 @@ void copyLayerDepths(const raster::LayeredTarget& layers, raster::TaskPool& pool
         auto copy = [&](const raster::ColorBuffer& color, const raster::DepthBuffer& depth,
                         std::vector<float>& d, uint32_t& row0, uint32_t& row1) {
             if (color.format == raster::ColorFormat::Half)
-                return copyAs.template operator()<HalfTexelBits>(
-                    [&](size_t k) { return color.half[k].bits(); }, depth, d, row0, row1);
-            return copyAs.template operator()<FloatTexelBits>(
-                [&](size_t k) { return std::bit_cast<uint32_t>(color.float32[k]); }, depth, d, row0,
-                row1);
+                return copyAs([&](size_t k) { return color.half[k].bits(); }, depth, d, row0, row1);
+            return copyAs([&](size_t k) { return std::bit_cast<uint32_t>(color.float32[k]); },
+                          depth, d, row0, row1);
         };
         copy(layers.color, layers.depth, scratch.depth[l], content.row0[l], content.row1[l]);
         if (transparency)
