@@ -34,9 +34,10 @@ TEST(TaskPool, SharesCoverEveryIndexOnceForAnyCount) {
         }
 }
 
-// A worker stalled in its first index: the others take the rest of its share (from its back),
-// so the job finishes. Without stealing the stalled worker's share would wait for it, and the
-// stall, which waits for every other index, would end only at its timeout.
+// The caller (worker 0, which always starts on its own share) stalled in its first index: the
+// other workers take the rest of its share (from its back), so the job finishes. Without
+// stealing that share would wait for the caller, and the stall, which waits for every other
+// index, would end only at its timeout.
 TEST(TaskPool, OtherWorkersFinishAStalledWorkersShare) {
     constexpr uint32_t kCount = 60;
     raster::TaskPool pool(3);
@@ -45,7 +46,7 @@ TEST(TaskPool, OtherWorkersFinishAStalledWorkersShare) {
     std::atomic<bool> timed_out{false};
     std::atomic<bool> stalled{false};
     pool.parallelFor(kCount, [&](uint32_t i, uint32_t worker) {
-        if (worker == 1 && !stalled.exchange(true)) {
+        if (worker == 0 && !stalled.exchange(true)) {
             const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
             while (done.load() < kCount - 1)
                 if (std::chrono::steady_clock::now() > until) {
