@@ -33,6 +33,9 @@ struct TileCounters {
     uint64_t covered = 0;  // samples inside a triangle
     uint64_t passed = 0;   // of those, passed the sink's test and the alpha test
     uint64_t rejected = 0; // of those, failed the sink's early test (never shaded)
+    // Time of the work the tile's task does after its raster (renderLayers: the fragment-copy
+    // pass), in ms.
+    double ms_after = 0.0;
 };
 
 // A shaded fragment as the output merger sees it.

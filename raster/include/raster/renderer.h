@@ -65,7 +65,10 @@ struct FrameStats {
     double ms_geometry = 0.0;
     double ms_binning = 0.0;
     double ms_raster = 0.0;
-    double ms_resolve = 0.0;   // layers: fragment-copy pass; lists: sort, cap and compact
+    // Lists: sort, cap and compact, after the raster. Layers: the fragment-copy pass, which
+    // runs in each tile's raster task while its layers are in the cache (so it is part of
+    // ms_raster too), summed over the tiles.
+    double ms_resolve = 0.0;
     uint64_t target_bytes = 0; // memory held by the render target's buffers
 };
 
