@@ -472,83 +472,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     for (std::vector<uint8_t>& used : st.list_nearest_used)
         used.reserve(tile_pixels);
 
-    // Collection: every fragment, in primitive order, into its tile's pool.
-    auto t0 = std::chrono::steady_clock::now();
-    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
-        // Each vector a task appends to is moved into a local and back (no allocation):
-        // neighbouring tiles' and workers' vector headers share cache lines, and updating one's
-        // end per fragment made the two workers fight over them.
-        std::vector<FragmentNode> nodes = std::move(st.list_pools[tile]);
-        nodes.clear();
-        ListSink sink{st.list_head, nodes};
-        if (early_k > 0) {
-            const TileRect r = tileRect(st.ctx.grid, tile);
-            // Only the counts are cleared: a pixel's keys beyond its count are never read.
-            std::vector<float>& nearest = st.list_nearest[worker];
-            std::vector<uint8_t>& used = st.list_nearest_used[worker];
-            nearest.resize(nearest_size);
-            used.assign(tile_pixels, 0);
-            sink.nearest = nearest.data();
-            sink.used = used.data();
-            sink.k = early_k;
-            sink.cap = desc.max_per_pixel;
-            sink.hidden_scale = hidden_scale;
-            sink.view = &view;
-            sink.frame_width = view.width;
-            sink.tile_x0 = r.x0, sink.tile_y0 = r.y0, sink.tile_size = st.ctx.grid.tile_size;
-        }
-        rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
-        st.list_pools[tile] = std::move(nodes);
-    });
-    const double ms_raster = msSince(t0);
-    uint64_t collected = 0;
-    for (const std::vector<FragmentNode>& p : st.list_pools)
-        collected += p.size();
-    // Reset field by field: the arrays are emptied but keep their memory for the next frame.
-    out.offsets.clear();
-    out.list_length.clear();
-    out.primitive.clear();
-    out.color.half.clear();
-    out.color.float32.clear();
-    out.depth.unorm16.clear();
-    out.depth.float32.clear();
-    out.depth.width = out.depth.height = 0;
-    out.width = view.width;
-    out.height = view.height;
-    out.desc = desc;
-    out.fragments_collected = collected;
-    out.fragments_rejected = 0;
-    out.fragments_hidden = 0;
-    out.fragments_kept = 0;
-    out.max_list_length = 0;
-    out.grew = false;
-    for (const TileCounters& c : st.tile_counters)
-        out.fragments_rejected += c.rejected;
-    out.node_capacity_used = desc.node_capacity;
-    // The collected nodes, plus what the resolve stores per kept fragment (at most all of them).
-    const uint64_t per_fragment = sizeof(FragmentNode) + bytesPerColor(desc.color_format) +
-                                  bytesPerDepth(desc.depth_format) + sizeof(uint32_t);
-    if (Status s = checkMemory(
-            options.memory_budget,
-            [&] { return std::to_string(collected) + " fragments in per-pixel lists"; },
-            mulBytes(collected, per_fragment));
-        !s.ok())
-        return s;
-    if (collected > desc.node_capacity) {
-        if (desc.on_overflow == OverflowPolicy::Fail)
-            return Status::error("fragment list overflow: " + std::to_string(collected) +
-                                 " fragments collected but the node pool holds " +
-                                 std::to_string(desc.node_capacity) +
-                                 " (raise the capacity or let the pool grow)");
-        // Collection counted every fragment, so growing the pool to the count needed loses
-        // nothing: the lists below are complete.
-        out.grew = true;
-        out.node_capacity_used = uint32_t(std::min<uint64_t>(collected, UINT32_MAX));
-    }
-
-    // Resolve (Selgrad et al. §4): sort each list and pick what it keeps into its tile's
-    // scratch, prefix sum over the counts, then copy every tile's lists into their slots.
-    t0 = std::chrono::steady_clock::now();
+    // Resolve (Selgrad et al. §4), per tile: sort each pixel's list and pick what it keeps into
+    // the tile's scratch (its counts into the offsets, summed below). Each tile's owner runs it
+    // right after collecting the tile, while the tile's pool is still in the cache (a second
+    // pass over the tiles read every list back from memory).
     const uint32_t cap = desc.max_per_pixel == 0 ? UINT32_MAX : desc.max_per_pixel;
     out.offsets.assign(pixels + 1, 0);
     out.list_length.assign(pixels, 0);
@@ -557,10 +484,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     std::vector<uint64_t>& hidden = st.list_hidden;
     longest.assign(tiles, 0);
     hidden.assign(tiles, 0);
-    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
+    const auto resolveTile = [&](uint32_t tile, uint32_t worker,
+                                 const std::vector<FragmentNode>& nodes) {
         const TileRect r = tileRect(st.ctx.grid, tile);
-        const std::vector<FragmentNode>& nodes = st.list_pools[tile];
-        // Filled and counted in locals and stored once (see the collection above).
+        // Filled and counted in locals and stored once (see the collection below).
         std::vector<FragmentNode> list = std::move(st.sort_scratch[worker]);
         std::vector<FragmentNode> kept = std::move(st.list_kept[tile]);
         kept.clear();
@@ -605,7 +532,86 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         st.list_kept[tile] = std::move(kept);
         longest[tile] = tile_longest;
         hidden[tile] = tile_hidden;
+    };
+
+    // Collection: every fragment, in primitive order, into its tile's pool.
+    auto t0 = std::chrono::steady_clock::now();
+    pool_.parallelFor(tiles, [&](uint32_t tile, uint32_t worker) {
+        // Each vector a task appends to is moved into a local and back (no allocation):
+        // neighbouring tiles' and workers' vector headers share cache lines, and updating one's
+        // end per fragment made the two workers fight over them.
+        std::vector<FragmentNode> nodes = std::move(st.list_pools[tile]);
+        nodes.clear();
+        ListSink sink{st.list_head, nodes};
+        if (early_k > 0) {
+            const TileRect r = tileRect(st.ctx.grid, tile);
+            // Only the counts are cleared: a pixel's keys beyond its count are never read.
+            std::vector<float>& nearest = st.list_nearest[worker];
+            std::vector<uint8_t>& used = st.list_nearest_used[worker];
+            nearest.resize(nearest_size);
+            used.assign(tile_pixels, 0);
+            sink.nearest = nearest.data();
+            sink.used = used.data();
+            sink.k = early_k;
+            sink.cap = desc.max_per_pixel;
+            sink.hidden_scale = hidden_scale;
+            sink.view = &view;
+            sink.frame_width = view.width;
+            sink.tile_x0 = r.x0, sink.tile_y0 = r.y0, sink.tile_size = st.ctx.grid.tile_size;
+        }
+        rasterizeTile(st.ctx, tile, sink, st.tile_counters[tile]);
+        const auto resolve_t0 = std::chrono::steady_clock::now();
+        resolveTile(tile, worker, nodes);
+        st.tile_counters[tile].ms_after = msSince(resolve_t0);
+        st.list_pools[tile] = std::move(nodes);
     });
+    const double ms_raster = msSince(t0);
+    uint64_t collected = 0;
+    for (const std::vector<FragmentNode>& p : st.list_pools)
+        collected += p.size();
+    // Reset field by field: the arrays are emptied but keep their memory for the next frame.
+    out.primitive.clear();
+    out.color.half.clear();
+    out.color.float32.clear();
+    out.depth.unorm16.clear();
+    out.depth.float32.clear();
+    out.depth.width = out.depth.height = 0;
+    out.width = view.width;
+    out.height = view.height;
+    out.desc = desc;
+    out.fragments_collected = collected;
+    out.fragments_rejected = 0;
+    out.fragments_hidden = 0;
+    out.fragments_kept = 0;
+    out.max_list_length = 0;
+    out.grew = false;
+    for (const TileCounters& c : st.tile_counters)
+        out.fragments_rejected += c.rejected;
+    out.node_capacity_used = desc.node_capacity;
+    // The collected nodes, plus what the resolve stores per kept fragment (at most all of them).
+    const uint64_t per_fragment = sizeof(FragmentNode) + bytesPerColor(desc.color_format) +
+                                  bytesPerDepth(desc.depth_format) + sizeof(uint32_t);
+    if (Status s = checkMemory(
+            options.memory_budget,
+            [&] { return std::to_string(collected) + " fragments in per-pixel lists"; },
+            mulBytes(collected, per_fragment));
+        !s.ok())
+        return s;
+    if (collected > desc.node_capacity) {
+        if (desc.on_overflow == OverflowPolicy::Fail)
+            return Status::error("fragment list overflow: " + std::to_string(collected) +
+                                 " fragments collected but the node pool holds " +
+                                 std::to_string(desc.node_capacity) +
+                                 " (raise the capacity or let the pool grow)");
+        // Collection counted every fragment, so growing the pool to the count needed loses
+        // nothing: the lists below are complete.
+        out.grew = true;
+        out.node_capacity_used = uint32_t(std::min<uint64_t>(collected, UINT32_MAX));
+    }
+
+    // The rest of the resolve: prefix sum over the kept counts, then every tile's kept
+    // fragments copied into their slots.
+    t0 = std::chrono::steady_clock::now();
     for (size_t p = 0; p < pixels; ++p)
         out.offsets[p + 1] += out.offsets[p];
     for (uint32_t t = 0; t < tiles; ++t) {
@@ -635,7 +641,10 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                 }
             }
     });
-    finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
+    double ms_resolve = msSince(t0); // the per-tile part ran in the collection's tasks
+    for (const TileCounters& tc : st.tile_counters)
+        ms_resolve += tc.ms_after;
+    finishStats(st.tile_counters, ms_raster, ms_resolve, out.bytes(), stats);
     return {};
 } catch (const std::bad_alloc&) {
     return outOfMemory("per-pixel fragment lists of a " + sizeText(view) + " image");

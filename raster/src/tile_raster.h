@@ -34,7 +34,7 @@ struct TileCounters {
     uint64_t passed = 0;   // of those, passed the sink's test and the alpha test
     uint64_t rejected = 0; // of those, failed the sink's early test (never shaded)
     // Time of the work the tile's task does after its raster (renderLayers: the fragment-copy
-    // pass), in ms.
+    // pass; renderFragmentLists: the sort and cap), in ms.
     double ms_after = 0.0;
 };
 

@@ -65,9 +65,10 @@ struct FrameStats {
     double ms_geometry = 0.0;
     double ms_binning = 0.0;
     double ms_raster = 0.0;
-    // Lists: sort, cap and compact, after the raster. Layers: the fragment-copy pass, which
-    // runs in each tile's raster task while its layers are in the cache (so it is part of
-    // ms_raster too), summed over the tiles.
+    // Lists: sort, cap and compact; layers: the fragment-copy pass. The per-tile part (the
+    // copy; the sort and cap) runs in each tile's raster task while the tile's data is in the
+    // cache, so it is part of ms_raster too: its time summed over the tiles, plus (lists) the
+    // compaction that follows.
     double ms_resolve = 0.0;
     uint64_t target_bytes = 0; // memory held by the render target's buffers
 };
