@@ -47,11 +47,18 @@ void axisTaps(uint32_t pixels, float origin, float spacing, uint32_t cells,
     }
 }
 
-// A list being traversed: its next fragment, its end, and the bilinear weight.
+// A list being traversed: its next fragment, its end, the bilinear weight, and the next
+// fragment's depth (+inf at the end: one compare tests both, as a sentinel would).
 struct Cursor {
     const LayerFragment* next = nullptr;
     const LayerFragment* end = nullptr;
     float weight = 0.0f;
+    float depth = 0.0f;
+
+    void advance() {
+        ++next;
+        depth = next != end ? next->depth : std::numeric_limits<float>::infinity();
+    }
 };
 
 // The rows of cells a level's bilinear taps read on one row of pixels: cell row j0 with weight
@@ -180,7 +187,7 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
                     const uint32_t last = tr.starts[r][cx[k] + 1];
                     if (!(w > 0.0f) || last == first)
                         continue;
-                    cur[c] = {tr.data[r] + first, tr.data[r] + last, w};
+                    cur[c] = {tr.data[r] + first, tr.data[r] + last, w, tr.data[r][first].depth};
                     rec.tap(side, s, c, cx[k], tr.cell_row[r], cur[c].next, w);
                     ++c;
                 }
@@ -211,12 +218,12 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
             for (uint32_t c = 0; c < classes; ++c)
                 for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
                     Cursor& cur = cur_side[lv[c]][k];
-                    while (cur.next != cur.end && cur.next->depth < seg.begin) {
+                    while (cur.depth < seg.begin) {
                         rec.skip(side, lv[c], k, si, *cur.next);
-                        ++cur.next;
+                        cur.advance();
                     }
-                    if (cur.next != cur.end && cur.next->depth < d0)
-                        d0 = cur.next->depth, any = true;
+                    if (cur.depth < d0)
+                        d0 = cur.depth, any = true;
                 }
             if (!any)
                 break;
@@ -231,7 +238,7 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
                 for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
                     Cursor& cur = cur_side[lv[c]][k];
                     float pr = 0.0f, pg = 0.0f, pb = 0.0f, pa = 0.0f;
-                    for (; cur.next != cur.end && cur.next->depth <= limit; ++cur.next) {
+                    for (; cur.depth <= limit; cur.advance()) {
                         const LayerFragment& f = *cur.next;
                         const float tr = shareInList(f, pieces, pa);
                         pr += tr * f.r, pg += tr * f.g, pb += tr * f.b, pa += tr * f.a;
