@@ -113,12 +113,28 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
     const size_t floats = size_t(width) * height * 4;
     AccumScratch local;
     AccumScratch& buffers = kept ? *kept : local;
-    buffers.sums.assign(floats, 0.0);
+    // Not cleared: the first view's rows store 0 + w·c (what adding to a cleared sum gives),
+    // so no frame-sized serial pass runs on the caller's thread (raster.md §6).
+    buffers.sums.resize(floats);
     double* acc = buffers.sums.data();
     raster::Frame& scratch = buffers.view;
     double& weight_sum = buffers.weight_sum;
     weight_sum = 0.0;
     const uint32_t n = samples.size();
+    if (n == 0)
+        std::fill(buffers.sums.begin(), buffers.sums.end(), 0.0);
+    // fn(begin, end) over the sums' floats of each image row, on the pool when there is one.
+    auto forRows = [&](auto&& fn) {
+        auto row = [&](uint32_t y, uint32_t) {
+            const size_t begin = size_t(y) * width * 4;
+            fn(begin, begin + size_t(width) * 4);
+        };
+        if (pool)
+            pool->parallelFor(height, row);
+        else
+            for (uint32_t y = 0; y < height; ++y)
+                row(y, 0);
+    };
     for (uint32_t i = 0; i < n; ++i) {
         const LensSample& ls = samples.sample(i);
         const glm::vec2 shift = settings.pixel_jitter ? pixelJitter(i) : glm::vec2(0.0f);
@@ -147,16 +163,15 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
         t0 = Clock::now();
         const double w = double(ls.weight);
         const float* color = src->color.data();
-        auto addRow = [&](uint32_t row, uint32_t) {
-            const size_t begin = size_t(row) * width * 4, end = begin + size_t(width) * 4;
-            for (size_t k = begin; k < end; ++k)
-                acc[k] += w * double(color[k]);
-        };
-        if (pool)
-            pool->parallelFor(height, addRow);
-        else
-            for (uint32_t row = 0; row < height; ++row)
-                addRow(row, 0);
+        const bool first = i == 0;
+        forRows([&](size_t begin, size_t end) {
+            if (first)
+                for (size_t k = begin; k < end; ++k)
+                    acc[k] = 0.0 + w * double(color[k]);
+            else
+                for (size_t k = begin; k < end; ++k)
+                    acc[k] += w * double(color[k]);
+        });
         weight_sum += w;
         buffers.last_view = src;
         stats.ms_accumulate += msSince(t0);
@@ -168,8 +183,10 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
     // Normalise by the weight sum (1 up to rounding) and store as float.
     t0 = Clock::now();
     const double inv = 1.0 / weight_sum;
-    for (size_t k = 0; k < floats; ++k)
-        out.color[k] = float(acc[k] * inv);
+    forRows([&](size_t begin, size_t end) {
+        for (size_t k = begin; k < end; ++k)
+            out.color[k] = float(acc[k] * inv);
+    });
     stats.ms_accumulate += msSince(t0);
     if (probes)
         probeResults(out, *probes);
