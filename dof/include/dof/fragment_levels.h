@@ -210,6 +210,10 @@ inline bool truncatedAt(const LevelBorders& borders, uint32_t level, float depth
 inline float shareInList(const LayerFragment& f, bool pieces, float pa) {
     if (!pieces)
         return 1.0f - pa;
+    // A list's first fragment (pa = 0) with 0 < α <= 1, the usual case: min(α, 1) / α = α / α,
+    // which IEEE division makes exactly 1, without dividing.
+    if (pa == 0.0f && f.a > 0.0f && f.a <= 1.0f)
+        return 1.0f;
     return f.a > 0.0f ? std::max(std::min(f.a, 1.0f - pa), 0.0f) / f.a : 0.0f;
 }
 
