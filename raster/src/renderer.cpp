@@ -343,13 +343,13 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
     // The overlapped intervals as ranges of stored depth [near, far), for the copy pass below:
     // the same decisions as testing distanceFromDepth(D) against the intervals, without a
     // division per pixel.
+    const bool copy = desc.routing == LayerRouting::MaxVertexDepth;
     float stored_near[kMaxLayers];
     float stored_far[kMaxLayers];
-    for (uint32_t l = 0; l < layers; ++l) {
+    for (uint32_t l = 0; copy && l < layers; ++l) {
         stored_near[l] = firstDepthAtDistance(view, intervals[l].near_d);
         stored_far[l] = firstDepthAtDistance(view, intervals[l].far_d);
     }
-    const bool copy = desc.routing == LayerRouting::MaxVertexDepth;
     auto t0 = std::chrono::steady_clock::now();
     pool_.parallelFor(st.ctx.grid.count(), [&](uint32_t tile, uint32_t) {
         // Every layer's pixels of the tile cleared by the tile's owner, as the frame's background
@@ -475,7 +475,9 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
     // Resolve (Selgrad et al. §4), per tile: sort each pixel's list and pick what it keeps into
     // the tile's scratch (its counts into the offsets, summed below). Each tile's owner runs it
     // right after collecting the tile, while the tile's pool is still in the cache (a second
-    // pass over the tiles read every list back from memory).
+    // pass over the tiles read every list back from memory). So the kept fragments (at most
+    // the pool again) are held before the memory budget is checked below, which then stops the
+    // image-sized arrays.
     const uint32_t cap = desc.max_per_pixel == 0 ? UINT32_MAX : desc.max_per_pixel;
     out.offsets.assign(pixels + 1, 0);
     out.list_length.assign(pixels, 0);
