@@ -383,9 +383,8 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
         // the result does not depend on the order of the copies. (BLEND fragments were routed one
         // by one to the layer owning their depth, so the transparent planes need no copy.) Run
         // on the tile just rasterized, by its owner: a pixel's copies read and write only that
-        // pixel's layers, which the tile's raster has just written and left in the cache (as a
-        // separate pass over the image, it read them back from memory: 1.17x on the whole
-        // decomposition with 16 layers).
+        // pixel's layers, which the tile's raster has just written and left in the cache (a
+        // separate pass over the image read them back from memory; raster.md §6).
         float snapshot[kMaxLayers];
         uint32_t covered[kMaxLayers];
         for (uint32_t y = r.y0; y < r.y1; ++y)
