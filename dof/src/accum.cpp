@@ -120,9 +120,7 @@ raster::Result<AccumStats> renderAccum(const raster::View& view, const ThinLens&
     raster::Frame& scratch = buffers.view;
     double& weight_sum = buffers.weight_sum;
     weight_sum = 0.0;
-    const uint32_t n = samples.size();
-    if (n == 0)
-        std::fill(buffers.sums.begin(), buffers.sums.end(), 0.0);
+    const uint32_t n = samples.size(); // >= 1 (checked above): view 0 writes every sum
     // fn(begin, end) over the sums' floats of each image row, on the pool when there is one.
     auto forRows = [&](auto&& fn) {
         auto row = [&](uint32_t y, uint32_t) {

@@ -186,6 +186,8 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
 namespace {
 
 // Records the target's times and size, and adds the per-tile fragment counters in tile order.
+// ms_resolve: the resolve's time after the raster; the tiles' own resolve work, done in their
+// raster tasks (TileCounters::ms_after), is added to it.
 void finishStats(const std::vector<TileCounters>& tiles, double ms_raster, double ms_resolve,
                  uint64_t target_bytes, FrameStats* stats) {
     if (!stats)
@@ -196,6 +198,7 @@ void finishStats(const std::vector<TileCounters>& tiles, double ms_raster, doubl
     for (const TileCounters& tc : tiles) {
         stats->fragments_covered += tc.covered;
         stats->fragments_passed += tc.passed;
+        stats->ms_resolve += tc.ms_after;
     }
 }
 
@@ -415,12 +418,8 @@ Status Renderer::renderLayers(const Scene& scene, const View& view, const Render
             }
         st.tile_counters[tile].ms_after = msSince(copy_t0);
     });
-    const double ms_raster = msSince(t0);
-    // The copy ran inside the tiles' tasks (within ms_raster): its time summed over the tiles.
-    double ms_copy = 0.0;
-    for (const TileCounters& tc : st.tile_counters)
-        ms_copy += tc.ms_after;
-    finishStats(st.tile_counters, ms_raster, ms_copy, out.bytes(), stats);
+    // The copy ran inside the tiles' tasks (within ms_raster); finishStats sums its time.
+    finishStats(st.tile_counters, msSince(t0), 0.0, out.bytes(), stats);
     return {};
 } catch (const std::bad_alloc&) {
     return outOfMemory("a " + sizeText(view) + " layered target");
@@ -642,10 +641,8 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
                 }
             }
     });
-    double ms_resolve = msSince(t0); // the per-tile part ran in the collection's tasks
-    for (const TileCounters& tc : st.tile_counters)
-        ms_resolve += tc.ms_after;
-    finishStats(st.tile_counters, ms_raster, ms_resolve, out.bytes(), stats);
+    // The sort and cap ran in the collection's tasks; finishStats adds their time.
+    finishStats(st.tile_counters, ms_raster, msSince(t0), out.bytes(), stats);
     return {};
 } catch (const std::bad_alloc&) {
     return outOfMemory("per-pixel fragment lists of a " + sizeText(view) + " image");
