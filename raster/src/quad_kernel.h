@@ -35,6 +35,15 @@ struct QuadOutput {
 
 using QuadKernel = void (*)(const QuadInput&, QuadOutput&);
 
+// The number of lanes set in a quad pair's mask, without a call: the baseline x86-64 build has
+// no popcnt instruction, so std::popcount is a library call there (1 % of a demo frame).
+constexpr uint32_t laneCount(uint32_t mask) {
+    static_assert(kQuadLanes == 8);
+    mask = mask - ((mask >> 1) & 0x55u);
+    mask = (mask & 0x33u) + ((mask >> 2) & 0x33u);
+    return (mask + (mask >> 4)) & 0x0fu;
+}
+
 void quadKernelScalar(const QuadInput& in, QuadOutput& out);
 // The AVX2 build of the same kernel; nullptr when not compiled in (FOCAL_NO_SIMD).
 QuadKernel quadKernelAvx2();

@@ -1,5 +1,7 @@
 #include "shading.h"
 
+#include "quad_kernel.h"
+
 #include <glm/exponential.hpp>
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
@@ -65,12 +67,12 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
     // costs about as much as 1.3 one-fragment lookups; callgrind on ToyCar, docs/raster.md 8.2)
     // or the image is beyond the kernel's integers.
     constexpr int kFewLanes = 1;
-    if (__builtin_popcount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
+    if (laneCount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
         for (int l = 0; l < kTextureLanes; ++l) {
-            if (!(lane_mask & (1u << l)))
-                continue;
             const glm::vec4 c =
-                sampleImage(image, sampler, ctx.filter, {lanes.u[l], lanes.v[l]}, lod[l / 4]);
+                lane_mask & (1u << l)
+                    ? sampleImage(image, sampler, ctx.filter, {lanes.u[l], lanes.v[l]}, lod[l / 4])
+                    : glm::vec4(0.0f); // a lane not asked for is still written (shading.h)
             for (int k = 0; k < 4; ++k)
                 rgba[k][l] = c[k];
         }

@@ -27,8 +27,12 @@ struct TriangleRaster {
     const ShadeVertex* v[3];
     const Material* material;
     Edge edges[3];
-    double inv_area2;
     const Primitive* prim;
+    // The quad kernel's input: everything but the edge values and the viewport lanes is the
+    // triangle's, filled once; shadeQuadPair sets those two per quad pair.
+    QuadInput quad;
+    // Pixel index of lane l relative to the quad pair's first pixel (lane = quad*4 + dy*2 + dx).
+    size_t lane_offset[kQuadLanes];
     // The vertex attributes and material constants the lanes share, filled when the first
     // lanes of the triangle pass the depth test (many small triangles never get there).
     bool frag_ready;
@@ -76,17 +80,9 @@ template <class Sink>
 void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int32_t qy, Sink& sink,
                    TileCounters& counters) {
     const SetupTri& t = *tr.tri;
-    QuadInput in;
-    for (int k = 0; k < 3; ++k) {
-        const Edge& e = tr.edges[k];
-        in.edge[k] = double(e.at(centre(qx), centre(qy)));
-        in.step_x[k] = double(e.a * kSubpixelOne);
-        in.step_y[k] = double(e.b * kSubpixelOne);
-        in.bias[k] = double(e.bias);
-        in.inv_w[k] = t.inv_w[k];
-        in.z[k] = t.z[k];
-    }
-    in.inv_area2 = tr.inv_area2;
+    QuadInput& in = tr.quad;
+    for (int k = 0; k < 3; ++k)
+        in.edge[k] = double(tr.edges[k].at(centre(qx), centre(qy)));
     in.valid = 0xffu;
     if (qx + 3 >= int32_t(ctx.grid.width) || qy + 1 >= int32_t(ctx.grid.height)) {
         in.valid = 0; // on the right or bottom border of the viewport
@@ -101,21 +97,17 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         return;
 
     const Material& m = *tr.material;
+    const size_t first_pixel = size_t(qy) * ctx.grid.width + size_t(qx);
     // Early depth test of every covered lane: legal because this tile's owner is the only
     // writer of the pixel. Lanes are distinct pixels and nothing is written before all are
     // tested, so testing them all first is the same as one at a time.
     uint32_t tested = 0;
-    for (int l = 0; l < kQuadLanes; ++l) {
-        if (!(q.mask & (1u << l)))
-            continue;
-        ++counters.covered;
-        const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
-        const size_t idx = size_t(y) * ctx.grid.width + size_t(x);
-        if (sink.test(idx, q.z[l], q.distance[l]))
-            tested |= 1u << l;
-        else
-            ++counters.rejected;
+    for (uint32_t rest = q.mask; rest != 0; rest &= rest - 1) {
+        const int l = std::countr_zero(rest);
+        tested |= uint32_t(sink.test(first_pixel + tr.lane_offset[l], q.z[l], q.distance[l])) << l;
     }
+    counters.covered += laneCount(q.mask);
+    counters.rejected += laneCount(q.mask & ~tested);
     if (tested == 0)
         return;
     if constexpr (requires(Sink & s) { s.writeDepth(size_t{}, 0.0f); }) {
@@ -124,16 +116,15 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         if (ctx.depth_only && m.alpha_mode == AlphaMode::Opaque) {
             for (uint32_t rest = tested; rest != 0; rest &= rest - 1) {
                 const int l = std::countr_zero(rest);
-                const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
-                sink.writeDepth(size_t(y) * ctx.grid.width + size_t(x), q.z[l]);
+                sink.writeDepth(first_pixel + tr.lane_offset[l], q.z[l]);
             }
-            counters.passed += uint64_t(std::popcount(tested));
+            counters.passed += laneCount(tested);
             return;
         }
     }
 
     const bool textured = m.base_color_texture.image >= 0 || m.emissive_texture.image >= 0;
-    QuadPairUv pair_uv{};
+    QuadPairUv pair_uv; // read only when textured, then written in full
     if (textured) {
         // Every lane is interpolated (helper pixels included) so each quad has coarse
         // derivatives, one pair per quad (as GPUs' ddx/ddy).
@@ -150,8 +141,9 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     const bool base_textured = m.base_color_texture.image >= 0;
     const bool emissive_textured =
         m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
-    // Zero-initialised: the fragment kernel reads every lane (fragment_kernel.h).
-    alignas(32) float base_texel[4][kTextureLanes] = {}, emissive_texel[4][kTextureLanes] = {};
+    // sampleQuadPair writes every lane (the fragment kernel reads every lane of the texels it
+    // is given, fragment_kernel.h); the arrays are read only when sampled.
+    alignas(32) float base_texel[4][kTextureLanes], emissive_texel[4][kTextureLanes];
     if (base_textured)
         sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, tested, base_texel);
     if (emissive_textured)
@@ -168,7 +160,7 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
                             emissive_textured ? emissive_texel : nullptr, tested, light, alpha);
     if (passed == 0)
         return;
-    counters.passed += uint64_t(std::popcount(passed));
+    counters.passed += laneCount(passed);
     const bool unlit = isUnlit(ctx.shade, m);
     if (!unlit) {
         const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
@@ -179,7 +171,6 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     const bool blend = m.alpha_mode == AlphaMode::Blend;
     for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
         const int l = std::countr_zero(rest);
-        const int32_t x = qx + (l >> 2) * 2 + (l & 1), y = qy + ((l >> 1) & 1);
         Fragment frag;
         frag.z = q.z[l];
         frag.distance = q.distance[l];
@@ -195,7 +186,7 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
             const glm::vec3 normal(light.normal[0][l], light.normal[1][l], light.normal[2][l]);
             frag.g = surfaceSample(ctx.shade, m, base, emissive, normal);
         }
-        sink.write(size_t(y) * ctx.grid.width + size_t(x), frag);
+        sink.write(first_pixel + tr.lane_offset[l], frag);
     }
 }
 
@@ -212,7 +203,17 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
         tr.v[k] = &geo.vertex(chunk, t.vertex[k]);
     tr.material = &materialOf(*ctx.shade.scene, prim);
     makeEdges(t, tr.edges);
-    tr.inv_area2 = 1.0 / double(t.area2);
+    for (int k = 0; k < 3; ++k) {
+        const Edge& e = tr.edges[k];
+        tr.quad.step_x[k] = double(e.a * kSubpixelOne);
+        tr.quad.step_y[k] = double(e.b * kSubpixelOne);
+        tr.quad.bias[k] = double(e.bias);
+        tr.quad.inv_w[k] = t.inv_w[k];
+        tr.quad.z[k] = t.z[k];
+    }
+    tr.quad.inv_area2 = 1.0 / double(t.area2);
+    for (int l = 0; l < kQuadLanes; ++l)
+        tr.lane_offset[l] = size_t((l >> 2) * 2 + (l & 1)) + size_t((l >> 1) & 1) * ctx.grid.width;
     tr.prim = &prim;
     tr.frag_ready = false;
     sink.beginTriangle(t, tr.material->alpha_mode == AlphaMode::Blend);
