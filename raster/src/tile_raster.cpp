@@ -268,7 +268,17 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
         for (size_t c = 0; c < geo.chunks.size(); ++c) {
             const ChunkBins& bins = (*ctx.bins)[c];
             const GeometryChunk& chunk = geo.chunks[c];
-            for (uint32_t i = bins.offsets[tile]; i < bins.offsets[tile + 1]; ++i) {
+            const uint32_t end = bins.offsets[tile + 1];
+            for (uint32_t i = bins.offsets[tile]; i < end; ++i) {
+                // A tile's triangles are scattered over its chunks, which outgrow the cache in
+                // scenes of 100k triangles (ToyCar: half of this loop's own time was the first
+                // load of each record): the record after next is fetched while this one is drawn.
+                if (i + 2 < end) {
+                    const char* next =
+                        reinterpret_cast<const char*>(&chunk.tris[bins.items[i + 2]]);
+                    __builtin_prefetch(next);
+                    __builtin_prefetch(next + sizeof(SetupTri) - 1);
+                }
                 const SetupTri& t = chunk.tris[bins.items[i]];
                 if (ctx.blend_last && isBlend(t) != (pass == 1))
                     continue;
