@@ -35,8 +35,13 @@ struct FrameSink {
         const float stored = frame.depth.quantize(z);
         return stored < frame.depth.load(pixel) && (!peel || stored > peel->load(pixel));
     }
-    // An unshaded OPAQUE fragment (RenderOptions::depth_only): what write stores of it.
+    // The two halves of write for a non-BLEND fragment, stored apart (the tile raster's light
+    // batch, and RenderOptions::depth_only's unshaded OPAQUE fragments, which store only depth).
     void writeDepth(size_t pixel, float z) { frame.depth.store(pixel, z); }
+    void writeColor(size_t pixel, glm::vec4 c) {
+        float* dst = &frame.color[pixel * 4];
+        dst[0] = c.r, dst[1] = c.g, dst[2] = c.b, dst[3] = c.a;
+    }
     void write(size_t pixel, const Fragment& f) {
         float* dst = &frame.color[pixel * 4];
         const glm::vec4 c =

@@ -73,12 +73,49 @@ glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
     return q.persp[0][l] * tr.v[0]->uv + q.persp[1][l] * tr.v[1]->uv + q.persp[2][l] * tr.v[2]->uv;
 }
 
+// Lit, non-BLEND lanes of a tile's quad pairs waiting for the lighting kernel, which then shades
+// eight at once where triangles leave one or two lanes per pair (dense: 1.5 on average). The
+// kernel's lanes are independent, so packing them changes no bits. A queued lane's depth is
+// stored when it is queued (the next triangle's depth test must see it), its colour when the
+// batch is shaded, in queue order, so a pixel queued twice still ends with its later triangle's
+// colour. The batch is shaded when full, when the lighting constants change, before any colour
+// written without it (unlit or BLEND lanes, which may land on a queued pixel) and at the end of
+// the tile. Only for sinks that store depth and colour apart (the frame).
+template <class Sink> constexpr bool kBatchesLight = requires(Sink& s) {
+    s.writeDepth(size_t{}, 0.0f);
+    s.writeColor(size_t{}, glm::vec4{});
+};
+
+// Pairs with more lit lanes than this are shaded on their own (after the queue): a kernel call
+// for five or more lanes costs less than copying them into the queue.
+constexpr uint32_t kQueuedLanes = 4;
+
+struct LightBatch {
+    LightLanes lanes{}; // zeroed once: the SIMD kernel reads every lane
+    size_t pixel[kLightLanes] = {};
+    float alpha[kLightLanes] = {};
+    LightMaterial material;
+    int count = 0;
+};
+
+template <class Sink> void shadeBatch(const RasterContext& ctx, LightBatch& batch, Sink& sink) {
+    if (batch.count == 0)
+        return;
+    const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
+    ctx.shade.light_kernel(ctx.shade.lights, ctx.shade.light_count, batch.material, eye,
+                           batch.lanes, batch.count);
+    for (int j = 0; j < batch.count; ++j)
+        sink.writeColor(batch.pixel[j], {batch.lanes.rgb[0][j], batch.lanes.rgb[1][j],
+                                         batch.lanes.rgb[2][j], batch.alpha[j]});
+    batch.count = 0;
+}
+
 // Two 2x2 quads at (qx, qy) and (qx + 2, qy) (qx a multiple of 4, qy even): the quad kernel finds
 // coverage, barycentrics and depth for the 8 pixels at once; the covered ones are then shaded and
 // handed to the sink one by one, in lane order.
 template <class Sink>
 void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int32_t qy, Sink& sink,
-                   TileCounters& counters) {
+                   LightBatch& batch, TileCounters& counters) {
     const SetupTri& t = *tr.tri;
     QuadInput& in = tr.quad;
     for (int k = 0; k < 3; ++k)
@@ -162,13 +199,40 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         return;
     counters.passed += laneCount(passed);
     const bool unlit = isUnlit(ctx.shade, m);
+    const bool blend = m.alpha_mode == AlphaMode::Blend;
+    if constexpr (kBatchesLight<Sink>) {
+        if (!unlit && !blend && laneCount(passed) <= kQueuedLanes) {
+            const LightMaterial material{m.metallic_factor, m.roughness_factor};
+            if (batch.count > 0 && (batch.material.metallic != material.metallic ||
+                                    batch.material.roughness != material.roughness))
+                shadeBatch(ctx, batch, sink);
+            batch.material = material;
+            for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
+                const int l = std::countr_zero(rest);
+                const size_t pixel = first_pixel + tr.lane_offset[l];
+                sink.writeDepth(pixel, q.z[l]);
+                const int j = batch.count++;
+                for (int c = 0; c < 3; ++c) {
+                    batch.lanes.albedo[c][j] = light.albedo[c][l];
+                    batch.lanes.emissive[c][j] = light.emissive[c][l];
+                    batch.lanes.world[c][j] = light.world[c][l];
+                    batch.lanes.normal[c][j] = light.normal[c][l];
+                }
+                batch.pixel[j] = pixel;
+                batch.alpha[j] = alpha[l];
+                if (batch.count == kLightLanes)
+                    shadeBatch(ctx, batch, sink);
+            }
+            return;
+        }
+        shadeBatch(ctx, batch, sink); // queued colours land before these
+    }
     if (!unlit) {
         const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
         ctx.shade.light_kernel(ctx.shade.lights, ctx.shade.light_count,
                                {m.metallic_factor, m.roughness_factor}, eye, light,
                                int(std::bit_width(passed)));
     }
-    const bool blend = m.alpha_mode == AlphaMode::Blend;
     for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
         const int l = std::countr_zero(rest);
         Fragment frag;
@@ -193,7 +257,7 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
 template <class Sink>
 void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, const SetupTri& t,
                        int32_t tile_x0, int32_t tile_y0, int32_t tile_x1, int32_t tile_y1,
-                       Sink& sink, TileCounters& counters) {
+                       Sink& sink, LightBatch& batch, TileCounters& counters) {
     const GeometryState& geo = *ctx.geometry;
     const Draw& draw = geo.draws[t.draw];
     const Primitive& prim = ctx.shade.scene->meshes[draw.mesh].primitives[draw.primitive];
@@ -237,7 +301,7 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
                 continue;
             for (int32_t qy = by; qy <= by1; qy += 2)
                 for (int32_t qx = bx; qx <= bx1; qx += 4)
-                    shadeQuadPair(ctx, tr, qx, qy, sink, counters);
+                    shadeQuadPair(ctx, tr, qx, qy, sink, batch, counters);
         }
     }
 }
@@ -263,6 +327,7 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
     // Counted on the stack and added once: neighbouring tiles' counters share cache lines, and
     // the workers usually raster neighbouring tiles (false sharing on every fragment).
     TileCounters local;
+    LightBatch batch;
     const int passes = ctx.blend_last ? 2 : 1;
     for (int pass = 0; pass < passes; ++pass)
         for (size_t c = 0; c < geo.chunks.size(); ++c) {
@@ -282,9 +347,11 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
                 const SetupTri& t = chunk.tris[bins.items[i]];
                 if (ctx.blend_last && isBlend(t) != (pass == 1))
                     continue;
-                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, sink, local);
+                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, sink, batch, local);
             }
         }
+    if constexpr (kBatchesLight<Sink>)
+        shadeBatch(ctx, batch, sink);
     counters.covered += local.covered;
     counters.passed += local.passed;
     counters.rejected += local.rejected;

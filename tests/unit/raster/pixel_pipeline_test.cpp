@@ -72,6 +72,36 @@ TEST(Depth, FloatDepthKeepsFarSurfacesApartWithATinyNearPlane) {
     EXPECT_NEAR(raster::distanceFromDepth(v, raster::depthFromDistance(v, 1e6f)), 1e6f, 1.0f);
 }
 
+// The tile raster queues the lit lanes of small triangles and shades them eight at a time
+// (tile_raster.cpp, LightBatch): a pixel queued twice must still end with the nearer
+// triangle's colour in either drawing order, the same colour that triangle gives alone (the
+// later one's queued colour lands last; the earlier one's queued depth rejects a farther one).
+TEST(Depth, QueuedLitLanesKeepPrimitiveOrder) {
+    raster::Material red = flatMaterial({1, 0, 0, 1}), green = flatMaterial({0, 1, 0, 1});
+    red.unlit = green.unlit = false; // the same lighting constants: one queue
+    const std::vector<uint32_t> tri = {0, 1, 2};
+    // About two pixels around the centre pixel (32, 32) at depth d (1 unit = 1 pixel at kDist).
+    auto tinyAt = [](float d) {
+        const float k = d / kDist;
+        return std::vector<glm::vec3>{
+            {-0.2f * k, -1.2f * k, -d}, {1.8f * k, -1.2f * k, -d}, {0.8f * k, 0.9f * k, -d}};
+    };
+    auto centre = [&](std::vector<std::pair<raster::Material, float>> drawn) {
+        raster::Scene s;
+        for (const auto& [m, d] : drawn)
+            addMesh(s, tinyAt(d), tri, addMaterial(s, m));
+        raster::FrameStats stats;
+        const raster::Frame f = render(s, pixelView(kSize, kSize, kDist), {}, 0, &stats);
+        EXPECT_LE(stats.fragments_passed, 2u * 4u * drawn.size()); // small: queued lanes
+        return pixel(f, 32, 32);
+    };
+    const glm::vec4 alone = centre({{green, 60.0f}});
+    EXPECT_GT(alone.g, 0.0f);
+    EXPECT_EQ(alone.r, 0.0f);
+    EXPECT_EQ(centre({{red, 64.0f}, {green, 60.0f}}), alone);
+    EXPECT_EQ(centre({{green, 60.0f}, {red, 64.0f}}), alone);
+}
+
 TEST(Depth, StoredValuesMatchTheProjection) {
     for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm16}) {
         const raster::Frame f = renderTwoPlanes(100.0f, 200.0f, format);
