@@ -74,7 +74,7 @@ glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
 }
 
 // Lit, non-BLEND lanes of a tile's quad pairs waiting for the lighting kernel, which then shades
-// eight at once where triangles leave one or two lanes per pair (dense: 1.5 on average). The
+// eight at once where triangles leave one or two lanes per pair (dense: 1.9 on average). The
 // kernel's lanes are independent, so packing them changes no bits. A queued lane's depth is
 // stored when it is queued (the next triangle's depth test must see it), its colour when the
 // batch is shaded, in queue order, so a pixel queued twice still ends with its later triangle's
