@@ -9,6 +9,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__x86_64__)
+#include <xmmintrin.h>
+#endif
+
 namespace raster {
 
 namespace {
@@ -80,12 +84,23 @@ int clipPolygon(ShadeVertex* poly, int n, ShadeVertex* scratch, uint32_t planes,
     return n;
 }
 
+// std::lrint without the libm call GCC emits for it (it inlines lrint only under
+// -fno-math-errno): on x86-64, glibc's lrintf is this one instruction, cvtss2si to a 64-bit
+// register, rounding to nearest even in the default mode; the same value for every input.
+long roundToLong(float x) {
+#if defined(__x86_64__)
+    return _mm_cvtss_si64(_mm_set_ss(x));
+#else
+    return std::lrint(x);
+#endif
+}
+
 ScreenVertex toScreen(const glm::vec4& clip, float half_w, float half_h) {
     const float inv_w = 1.0f / clip.w;
     const float px = (clip.x * inv_w + 1.0f) * half_w;
     const float py = (1.0f - clip.y * inv_w) * half_h;
-    return {int32_t(std::lrint(px * float(kSubpixelOne))),
-            int32_t(std::lrint(py * float(kSubpixelOne))), clip.z * inv_w, inv_w};
+    return {int32_t(roundToLong(px * float(kSubpixelOne))),
+            int32_t(roundToLong(py * float(kSubpixelOne))), clip.z * inv_w, inv_w};
 }
 
 int32_t ceilDiv(int64_t a, int64_t b) {
