@@ -163,7 +163,6 @@ void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& dr
     }
     t.area2 = area2;
     t.draw = uint32_t(&draw - ctx.state.draws.data());
-    t.triangle = triangle;
     t.primitive_id = uint32_t(draw.first_triangle + triangle);
     t.max_distance = max_distance;
     t.front_facing = front_facing;

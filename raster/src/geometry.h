@@ -79,7 +79,6 @@ struct SetupTri {
     float inv_w[3];        // 1/w per vertex, for perspective-correct interpolation
     uint32_t vertex[3];    // ShadeVertex references: kClipped bit => chunk-local clipped vertex
     uint32_t draw;         // index into GeometryState::draws
-    uint32_t triangle;     // index of the source triangle within its draw
     uint32_t primitive_id; // submission index of the source triangle over the whole frame
     float max_distance;    // largest view distance (w) of the source triangle's vertices
     int32_t min_x, min_y, max_x, max_y; // covered pixel bounds (inclusive), inside the viewport

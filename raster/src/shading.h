@@ -39,8 +39,9 @@ struct QuadPairUv {
 // `ref`'s texture (texture transform, level of detail, sampler) at the lanes of a quad pair set
 // in `lanes`: linear RGBA per lane, the same bits as a lookup of that one fragment. Every lane of
 // `rgba` is written (those not asked for with unspecified values: the fragment kernel reads
-// them). One level of detail per quad, as GPUs compute it from the quad's derivatives. The lanes are filtered together by the texture kernel, or one by one when only
-// a few are asked for (the kernel's cost does not depend on how many lanes are used).
+// them). One level of detail per quad, as GPUs compute it from the quad's derivatives. The
+// lanes are filtered together by the texture kernel, or one by one when only a few are asked
+// for (the kernel's cost does not depend on how many lanes are used).
 void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
                     uint32_t lanes, float rgba[4][kTextureLanes]);
 
