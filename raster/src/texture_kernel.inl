@@ -39,19 +39,15 @@ inline void wrapLanes(const int32_t* i, int32_t n, Wrap mode, int32_t* w0, int32
     if ((period & (period - 1)) == 0) {
         // A power-of-two period (most textures): i mod period is the low bits of i in two's
         // complement, the same integer without the division.
-        for (int l = 0; l < kLanes; ++l) {
-            const int32_t m = i[l] & (period - 1);
-            w0[l] = m;
-            w1[l] = m + 1 == period ? 0 : m + 1;
-        }
+        for (int l = 0; l < kLanes; ++l)
+            w0[l] = i[l] & (period - 1);
     } else {
         const double period_d = double(period);
-        for (int l = 0; l < kLanes; ++l) {
-            const int32_t m = i[l] - period * int32_t(__builtin_floor(double(i[l]) / period_d));
-            w0[l] = m;
-            w1[l] = m + 1 == period ? 0 : m + 1;
-        }
+        for (int l = 0; l < kLanes; ++l)
+            w0[l] = i[l] - period * int32_t(__builtin_floor(double(i[l]) / period_d));
     }
+    for (int l = 0; l < kLanes; ++l)
+        w1[l] = w0[l] + 1 == period ? 0 : w0[l] + 1;
     if (mode == Wrap::MirroredRepeat)
         for (int l = 0; l < kLanes; ++l) {
             w0[l] = w0[l] < n ? w0[l] : period - 1 - w0[l];

@@ -31,8 +31,8 @@ struct TriangleRaster {
     // The quad kernel's input: everything but the edge values and the viewport lanes is the
     // triangle's, filled once; shadeQuadPair sets those two per quad pair.
     QuadInput quad;
-    // Pixel index of lane l relative to the quad pair's first pixel (lane = quad*4 + dy*2 + dx).
-    size_t lane_offset[kQuadLanes];
+    // Pixel index of lane l relative to the quad pair's first pixel (the tile's, laneOffsets).
+    const size_t* lane_offset;
     // The vertex attributes and material constants the lanes share, filled when the first
     // lanes of the triangle pass the depth test (many small triangles never get there).
     bool frag_ready;
@@ -257,7 +257,8 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
 template <class Sink>
 void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, const SetupTri& t,
                        int32_t tile_x0, int32_t tile_y0, int32_t tile_x1, int32_t tile_y1,
-                       Sink& sink, LightBatch& batch, TileCounters& counters) {
+                       const size_t* lane_offset, Sink& sink, LightBatch& batch,
+                       TileCounters& counters) {
     const GeometryState& geo = *ctx.geometry;
     const Draw& draw = geo.draws[t.draw];
     const Primitive& prim = ctx.shade.scene->meshes[draw.mesh].primitives[draw.primitive];
@@ -276,8 +277,7 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
         tr.quad.z[k] = t.z[k];
     }
     tr.quad.inv_area2 = 1.0 / double(t.area2);
-    for (int l = 0; l < kQuadLanes; ++l)
-        tr.lane_offset[l] = size_t((l >> 2) * 2 + (l & 1)) + size_t((l >> 1) & 1) * ctx.grid.width;
+    tr.lane_offset = lane_offset;
     tr.prim = &prim;
     tr.frag_ready = false;
     sink.beginTriangle(t, tr.material->alpha_mode == AlphaMode::Blend);
@@ -328,6 +328,10 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
     // the workers usually raster neighbouring tiles (false sharing on every fragment).
     TileCounters local;
     LightBatch batch;
+    // Pixel index of lane l relative to a quad pair's first pixel (lane = quad*4 + dy*2 + dx).
+    size_t lane_offset[kQuadLanes];
+    for (int l = 0; l < kQuadLanes; ++l)
+        lane_offset[l] = size_t((l >> 2) * 2 + (l & 1)) + size_t((l >> 1) & 1) * g.width;
     const int passes = ctx.blend_last ? 2 : 1;
     for (int pass = 0; pass < passes; ++pass)
         for (size_t c = 0; c < geo.chunks.size(); ++c) {
@@ -347,7 +351,8 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
                 const SetupTri& t = chunk.tris[bins.items[i]];
                 if (ctx.blend_last && isBlend(t) != (pass == 1))
                     continue;
-                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, sink, batch, local);
+                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, lane_offset, sink, batch,
+                                  local);
             }
         }
     if constexpr (kBatchesLight<Sink>)
