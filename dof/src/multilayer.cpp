@@ -135,11 +135,22 @@ void rowTaps(const TraversalFrame& tf, uint32_t y, TapRows (&rows)[2][kMaxTraver
 }
 
 // The cursors of one pixel's taps, per side and level of T: working memory a row's task reuses
-// for its pixels (not initialised per pixel: traversePixel sets what it reads).
+// for its pixels (not initialised per pixel: traversePixel sets what it reads). `closest` is the
+// smallest next depth among a level's cursors (+inf when it has none left): a segment whose
+// levels have nothing closer than its end is passed with two compares, not a scan of the taps.
 struct PixelCursors {
     Cursor cursors[2][kMaxTraversalLevels][4];
     uint32_t count[2][kMaxTraversalLevels];
+    float closest[2][kMaxTraversalLevels];
 };
+
+// The smallest next depth among `count` cursors (+inf for none).
+float closestOf(const Cursor* cur, uint32_t count) {
+    float d = std::numeric_limits<float>::infinity();
+    for (uint32_t k = 0; k < count; ++k)
+        d = std::min(d, cur[k].depth);
+    return d;
+}
 
 // The render's recorder: records nothing (every call compiles away).
 struct NoRecorder {
@@ -164,15 +175,16 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
     const std::vector<LevelBorders::Segment>& segments = st.segments;
     // Bilinear taps of every level at the pixel centre, in the order (i0, j0), (i1, j0),
     // (i0, j1), (i1, j1); taps with weight 0 or an empty list are left out, since they add w·0
-    // to every slice. `present` marks the levels with a tap left, per side.
+    // to every slice.
     Cursor(&cursors)[2][kMaxTraversalLevels][4] = pc.cursors;
     uint32_t(&cursor_count)[2][kMaxTraversalLevels] = pc.count;
-    uint64_t present[2] = {0, 0};
+    float(&closest)[2][kMaxTraversalLevels] = pc.closest;
     for (uint32_t side = 0; side < tf.sides; ++side)
         for (uint32_t s = 0; s <= tf.n; ++s) {
             const TapRows& tr = rows[side][s];
             if (tr.count == 0) {
                 cursor_count[side][s] = 0;
+                closest[side][s] = std::numeric_limits<float>::infinity();
                 continue;
             }
             const AxisTap ax = st.tx[s][x];
@@ -192,7 +204,7 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
                     ++c;
                 }
             cursor_count[side][s] = c;
-            present[side] |= uint64_t(c != 0) << s;
+            closest[side][s] = closestOf(cur, c);
         }
     float cr = 0.0f, cg = 0.0f, cb = 0.0f, ca = 0.0f;
     float ca_g = 0.0f, ga = 0.0f, last_d = 0.0f;
@@ -202,29 +214,34 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
         if (ca >= kOpaque)
             break;
         const uint32_t side = st.seg_side[si];
-        if ((present[side] & st.seg_levels[si]) == 0)
-            continue; // nothing to read in this segment
         const LevelBorders::Segment& seg = segments[si];
+        float* closest_side = closest[side];
+        if (!(std::min(closest_side[seg.lo], closest_side[seg.hi]) < seg.end))
+            continue; // nothing to read in this segment
         Cursor(&cur_side)[kMaxTraversalLevels][4] = cursors[side];
         const uint32_t* count_side = cursor_count[side];
         const uint32_t lv[2] = {seg.lo, seg.hi};
         const uint32_t classes = seg.hi == seg.lo ? 1 : 2;
         while (ca < kOpaque) {
             // The closest fragment in the segment over both levels' taps, after skipping what
-            // lies in front of the segment (not asked of this level there; a no-op after the
-            // first slice, since cursors only advance).
+            // lies in front of the segment (not asked of this level there; only a level whose
+            // cursors last moved in an earlier segment has any, since cursors only advance).
             float d0 = seg.end;
             bool any = false;
-            for (uint32_t c = 0; c < classes; ++c)
-                for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
-                    Cursor& cur = cur_side[lv[c]][k];
-                    while (cur.depth < seg.begin) {
-                        rec.skip(side, lv[c], k, si, *cur.next);
-                        cur.advance();
+            for (uint32_t c = 0; c < classes; ++c) {
+                if (closest_side[lv[c]] < seg.begin) {
+                    for (uint32_t k = 0; k < count_side[lv[c]]; ++k) {
+                        Cursor& cur = cur_side[lv[c]][k];
+                        while (cur.depth < seg.begin) {
+                            rec.skip(side, lv[c], k, si, *cur.next);
+                            cur.advance();
+                        }
                     }
-                    if (cur.depth < d0)
-                        d0 = cur.depth, any = true;
+                    closest_side[lv[c]] = closestOf(cur_side[lv[c]], count_side[lv[c]]);
                 }
+                if (closest_side[lv[c]] < d0)
+                    d0 = closest_side[lv[c]], any = true;
+            }
             if (!any)
                 break;
             // One slice: the §5.1 merge across taps and the two levels, weighted by the
@@ -248,6 +265,7 @@ uint64_t traversePixel(const TraversalFrame& tf, const TapRows (&rows)[2][kMaxTr
                     part[c][0] += w * pr, part[c][1] += w * pg, part[c][2] += w * pb;
                     part[c][3] += w * pa;
                 }
+                closest_side[lv[c]] = closestOf(cur_side[lv[c]], count_side[lv[c]]);
             }
             const float sa = part[0][3] + part[1][3];
             if (!(sa > 0.0f)) {
@@ -652,20 +670,16 @@ raster::Status Multilayer::renderFromLists(const raster::FragmentLists& lists,
     } else {
         out.level_rgba.clear();
     }
-    // Per segment of T: the last depth a slice may reach (below its end), the levels it reads
-    // as a bit mask, and the side whose levels those are (looked up, not recomputed, per pixel).
+    // Per segment of T: the last depth a slice may reach (below its end) and the side whose
+    // levels it reads (looked up, not recomputed, per pixel).
     std::vector<float>& seg_last = trav.seg_last;
-    std::vector<uint64_t>& seg_levels = trav.seg_levels;
     std::vector<uint8_t>& seg_side = trav.seg_side;
     seg_last.resize(segments.size());
-    seg_levels.resize(segments.size());
     seg_side.resize(segments.size());
     for (size_t i = 0; i < segments.size(); ++i) {
         seg_last[i] = std::nextafter(segments[i].end, 0.0f);
-        seg_levels[i] = (uint64_t{1} << segments[i].lo) | (uint64_t{1} << segments[i].hi);
         seg_side[i] = uint8_t(tf.sideOf(segments[i]));
     }
-    static_assert(kMaxTraversalLevels <= 64);
     std::vector<uint64_t>& row_slices = row_slices_;
     row_slices.assign(height, 0);
     pool.parallelFor(height, [&](uint32_t y, uint32_t) {

@@ -304,11 +304,10 @@ public:
         float scale = 1.0f;       // 1 + ε: a slice's merge window (§5.1)
         float group_scale = 0.0f; // LayerBlend::Additive: 1 + additive_gap, else 0
         bool asymmetric = false;  // near and far aperture levels built apart
-        // T as segments (split at d_f when asymmetric), each one's last depth, levels and side
+        // T as segments (split at d_f when asymmetric), each one's last depth and side
         // (TraversalFrame::sideOf).
         std::vector<LevelBorders::Segment> segments;
         std::vector<float> seg_last;
-        std::vector<uint64_t> seg_levels;
         std::vector<uint8_t> seg_side;
         // The bilinear taps of every level of T at the pixel centres, per axis.
         std::vector<std::vector<AxisTap>> tx, ty;
