@@ -40,7 +40,7 @@ bool fitsTextureKernel(const MipLevel& level) {
 
 TextureLevel kernelLevel(const MipLevel& level) {
     return {reinterpret_cast<const TexelWord*>(level.rgba8.data()), int32_t(level.width),
-            int32_t(level.height)};
+            int32_t(level.height), level.linear.empty() ? nullptr : level.linear.data()};
 }
 
 } // namespace

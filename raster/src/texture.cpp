@@ -139,6 +139,20 @@ void buildMipChain(Image& image) {
         }
         image.levels.push_back(std::move(dst));
     }
+    for (MipLevel& level : image.levels) {
+        const size_t texels = size_t(level.width) * level.height;
+        if (texels > kLinearLevelMaxTexels) {
+            level.linear.clear();
+            continue;
+        }
+        level.linear.resize(texels * 4);
+        for (size_t i = 0; i < texels; ++i) {
+            const glm::vec4 c =
+                fetch(level, image.srgb, int(i % level.width), int(i / level.width));
+            for (int k = 0; k < 4; ++k)
+                level.linear[4 * i + k] = c[k];
+        }
+    }
 }
 
 LevelSelection selectLevels(const Image& image, const Sampler& sampler, FilterOverride filter,

@@ -27,6 +27,10 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "TexelWord assumes RGBA
 struct TextureLevel {
     const TexelWord* texels = nullptr; // width * height words, row 0 first
     int32_t width = 1, height = 1;     // within the kernel limits above
+    // The texels decoded (MipLevel::linear: 4 floats each, as the query's decoding gives them),
+    // or nullptr. The AVX2 build loads them when present; the scalar reference always decodes
+    // the words, which is how the tests hold the two to the same bits.
+    const float* linear = nullptr;
 };
 
 // What the lanes share: one filter inside the level(s), the wrap modes and the decoding.

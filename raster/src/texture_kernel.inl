@@ -2,7 +2,8 @@
 // texture_kernel_avx2.cpp. Lane loops over fixed-size arrays doing, per lane, the operations of
 // texture.cpp's sampleLevel in the same order, so the results are its bits; branches only on
 // what the lanes share. No calls to inline library templates (see quad_kernel.inl). The table
-// loads (texel words, the sRGB table) go through gatherLanes: AVX2 gathers in the AVX2 build.
+// loads (texel words, the sRGB table) go through gatherLanes: AVX2 gathers in the AVX2 build,
+// which loads a level's decoded texels instead where it has them (loadLinearLanes).
 #ifndef FOCAL_TEXTURE_KERNEL_NAME
 #error "define FOCAL_TEXTURE_KERNEL_NAME before including texture_kernel.inl"
 #endif
@@ -72,6 +73,22 @@ template <class T> void gatherLanes(const T* table, const int32_t* index, T* out
 #endif
 }
 
+#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
+// The decoded texels at `index` of every lane, channel by channel: eight 16-byte loads (lanes l
+// and l + 4 into the two halves of one register) and a 4x4 transpose within each half.
+inline void loadLinearLanes(const float* linear, const int32_t* index, float (*rgba)[kLanes]) {
+    __m256 t[4];
+    for (int l = 0; l < 4; ++l)
+        t[l] = _mm256_loadu2_m128(linear + 4 * size_t(index[l + 4]), linear + 4 * size_t(index[l]));
+    const __m256 rg01 = _mm256_unpacklo_ps(t[0], t[1]), ba01 = _mm256_unpackhi_ps(t[0], t[1]);
+    const __m256 rg23 = _mm256_unpacklo_ps(t[2], t[3]), ba23 = _mm256_unpackhi_ps(t[2], t[3]);
+    _mm256_storeu_ps(rgba[0], _mm256_shuffle_ps(rg01, rg23, _MM_SHUFFLE(1, 0, 1, 0)));
+    _mm256_storeu_ps(rgba[1], _mm256_shuffle_ps(rg01, rg23, _MM_SHUFFLE(3, 2, 3, 2)));
+    _mm256_storeu_ps(rgba[2], _mm256_shuffle_ps(ba01, ba23, _MM_SHUFFLE(1, 0, 1, 0)));
+    _mm256_storeu_ps(rgba[3], _mm256_shuffle_ps(ba01, ba23, _MM_SHUFFLE(3, 2, 3, 2)));
+}
+#endif
+
 // Texel (x, y) of every lane as linear RGBA (texture.cpp's fetch). Indices are int32, below
 // kTextureKernelMaxTexels: the gathers' indices.
 inline void fetchLanes(const TextureLevel& level, const float* lut, const int32_t* x,
@@ -79,6 +96,12 @@ inline void fetchLanes(const TextureLevel& level, const float* lut, const int32_
     alignas(32) int32_t index[kLanes];
     for (int l = 0; l < kLanes; ++l)
         index[l] = y[l] * level.width + x[l];
+#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
+    if (level.linear) {
+        loadLinearLanes(level.linear, index, rgba);
+        return;
+    }
+#endif
     alignas(32) uint32_t t[kLanes];
     gatherLanes(level.texels, index, t);
     if (lut) {

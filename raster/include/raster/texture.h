@@ -30,7 +30,17 @@ struct MipLevel {
     uint32_t width = 0;
     uint32_t height = 0;
     std::vector<uint8_t> rgba8; // width*height*4, row 0 is the top row (glTF uv (0,0))
+    // The same texels decoded as a lookup decodes them (linear RGBA floats, sRGB colour through
+    // the decoding table), for levels of at most kLinearLevelMaxTexels texels (buildMipChain);
+    // empty otherwise. The texture kernel loads a texel's four channels from here in one
+    // access instead of gathering its word and then three table entries.
+    std::vector<float> linear;
 };
+
+// The largest mip level that also keeps its decoded texels (MipLevel::linear): 1024 x 1024,
+// 16 MB next to the level's 4 MB of bytes. A larger level 0 keeps only its bytes; its smaller
+// levels, which minified lookups read, are decoded.
+constexpr uint64_t kLinearLevelMaxTexels = uint64_t{1} << 20;
 
 // What a material samples a texture for (glTF 2.0 §3.9.2-3.9.5).
 enum class TextureRole : uint8_t { BaseColor, Emissive, MetallicRoughness, Normal, Occlusion };
@@ -65,7 +75,8 @@ struct Image {
 };
 
 // Replaces image.levels[1..] with the full chain down to 1x1: each texel of level i+1 is the
-// average of the (up to) 2x2 texels of level i, computed in linear light and re-encoded.
+// average of the (up to) 2x2 texels of level i, computed in linear light and re-encoded. Then
+// fills MipLevel::linear of every level of at most kLinearLevelMaxTexels texels.
 void buildMipChain(Image& image);
 
 // The filter the CLI may force on every sampler (--texture-filter).

@@ -172,10 +172,10 @@ TEST(Simd, FragmentKernelMatchesScalarBitForBit) {
     }
 }
 
-// Lane by lane, the texture kernel (scalar build, and the AVX2 build where there is one) gives
-// the bits of sampleImage, the one-fragment reference: every wrap mode and filter, sRGB and
-// linear images, sizes that are not powers of two, and coordinates far outside [0, 1],
-// non-finite ones included.
+// Lane by lane, the texture kernel (scalar build, and the AVX2 build where there is one, from
+// the texel words and from the decoded texels) gives the bits of sampleImage, the one-fragment
+// reference: every wrap mode and filter, sRGB and linear images, sizes that are not powers of
+// two, and coordinates far outside [0, 1], non-finite ones included.
 TEST(Simd, TextureKernelMatchesSampleImageBitForBit) {
     const raster::TextureKernel wide = raster::textureKernelAvx2();
     const bool has_wide = wide && __builtin_cpu_supports("avx2");
@@ -256,6 +256,15 @@ TEST(Simd, TextureKernelMatchesSampleImageBitForBit) {
                 if (has_wide) {
                     wide(q, b);
                     ASSERT_EQ(std::memcmp(a.rgba, b.rgba, sizeof(a.rgba)), 0) << i;
+                    raster::TextureQuery decoded = q;
+                    for (int k = 0; k < 2; ++k) {
+                        const raster::MipLevel& level = img.levels[k ? sel.level1 : sel.level0];
+                        ASSERT_EQ(level.linear.size(), level.rgba8.size());
+                        decoded.level[k].linear = level.linear.data();
+                    }
+                    raster::TextureLanes c = lanes;
+                    wide(decoded, c);
+                    ASSERT_EQ(std::memcmp(a.rgba, c.rgba, sizeof(a.rgba)), 0) << i;
                 }
                 ++checked;
             }

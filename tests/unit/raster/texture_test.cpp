@@ -60,6 +60,26 @@ TEST(Texture, MipChainAveragesInLinearLight) {
     EXPECT_EQ(non_square.levels[3].width, 1u);
 }
 
+// Levels up to kLinearLevelMaxTexels keep their texels decoded as a lookup decodes them (sRGB
+// colour through the table, alpha and linear images by 1/255); larger ones keep only bytes.
+TEST(Texture, MipChainDecodesTheLevelsUpToTheLimit) {
+    const Image srgb = makeImage(3, 2, true, [](uint32_t x, uint32_t y) { return 40 * x + y; });
+    for (const raster::MipLevel& level : srgb.levels) {
+        ASSERT_EQ(level.linear.size(), level.rgba8.size());
+        for (size_t i = 0; i < level.rgba8.size(); ++i)
+            EXPECT_EQ(level.linear[i], i % 4 == 3 ? float(level.rgba8[i]) * (1.0f / 255.0f)
+                                                  : raster::srgbDecodeTable()[level.rgba8[i]])
+                << i;
+    }
+    const Image linear = makeImage(2, 2, false, [](uint32_t x, uint32_t) { return 200 + x; });
+    EXPECT_EQ(linear.levels[0].linear[4], 201.0f * (1.0f / 255.0f));
+    // 2048 x 1024 = 2^21 texels: level 0 stays bytes only, level 1 (2^19) is decoded.
+    const Image large = makeImage(2048, 1024, true, [](uint32_t, uint32_t) { return 9; });
+    static_assert(raster::kLinearLevelMaxTexels == (uint64_t{1} << 20));
+    EXPECT_TRUE(large.levels[0].linear.empty());
+    EXPECT_EQ(large.levels[1].linear.size(), large.levels[1].rgba8.size());
+}
+
 TEST(Texture, NearestFetchesTexelsAndWrapModesWrap) {
     const Image img = makeImage(4, 4, false, [](uint32_t x, uint32_t) { return x * 80; });
     Sampler s;
