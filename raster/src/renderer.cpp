@@ -496,8 +496,20 @@ Status Renderer::renderFragmentLists(const Scene& scene, const View& view,
         for (uint32_t y = r.y0; y < r.y1; ++y)
             for (uint32_t x = r.x0; x < r.x1; ++x) {
                 const size_t p = size_t(y) * view.width + x;
+                // An empty or one-fragment list (most pixels) is already sorted, and its
+                // fragment is kept: cap >= 1 and nothing is kept in front to hide it.
+                const uint32_t head = st.list_head[p];
+                if (head == kNoNode || nodes[head].next == kNoNode) {
+                    const uint32_t n = head == kNoNode ? 0 : 1;
+                    tile_longest = std::max(tile_longest, n);
+                    out.list_length[p] = n;
+                    out.offsets[p + 1] = n;
+                    if (n == 1)
+                        kept.push_back(nodes[head]);
+                    continue;
+                }
                 list.clear();
-                for (uint32_t i = st.list_head[p]; i != kNoNode; i = nodes[i].next)
+                for (uint32_t i = head; i != kNoNode; i = nodes[i].next)
                     list.push_back(nodes[i]);
                 const uint32_t n = uint32_t(list.size());
                 tile_longest = std::max(tile_longest, n);
