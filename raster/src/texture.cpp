@@ -146,12 +146,12 @@ void buildMipChain(Image& image) {
             continue;
         }
         level.linear.resize(texels * 4);
-        for (size_t i = 0; i < texels; ++i) {
-            const glm::vec4 c =
-                fetch(level, image.srgb, int(i % level.width), int(i / level.width));
-            for (int k = 0; k < 4; ++k)
-                level.linear[4 * i + k] = c[k];
-        }
+        float* out = level.linear.data();
+        for (uint32_t y = 0; y < level.height; ++y)
+            for (uint32_t x = 0; x < level.width; ++x, out += 4) {
+                const glm::vec4 c = fetch(level, image.srgb, int(x), int(y));
+                out[0] = c.r, out[1] = c.g, out[2] = c.b, out[3] = c.a;
+            }
     }
 }
 
