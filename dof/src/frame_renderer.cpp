@@ -25,6 +25,7 @@ struct PinholeCall {
     FrameReport& report;
     bool kept;
     mutable bool depth_rendered = false; // multiview's depth-only pinhole was rendered
+    mutable bool rendered = false;       // accum: a view was rendered in this call
 };
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -317,6 +318,11 @@ raster::Status FrameRenderer::renderFrame(const raster::Scene& scene, const rast
                 accum_.transparent_depth = pinhole_.transparent_depth;
                 return {};
             }
+            // The views after the first are of the same scene, unchanged within this call: the
+            // renderer keeps its world-space vertices (raster::Renderer::promiseSceneUnchanged).
+            if (call.rendered)
+                renderer_->promiseSceneUnchanged();
+            call.rendered = true;
             return renderPinhole(call.scene, v, call.options, f, call.report);
         };
         AccumSettings settings = m->settings;

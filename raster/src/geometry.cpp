@@ -219,31 +219,40 @@ void processTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& 
 
 } // namespace
 
-void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryState& state) {
-    // List the draws in submission order: instances, then their primitives.
-    state.draws.clear();
-    uint32_t vertex_count = 0;
-    uint64_t triangle_count = 0;
-    for (uint32_t i = 0; i < scene.instances.size(); ++i) {
-        const Instance& inst = scene.instances[i];
-        const Mesh& mesh = scene.meshes[inst.mesh];
-        const glm::mat3 linear(inst.world);
-        const bool mirrored = glm::determinant(linear) < 0.0f;
-        const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
-        for (uint32_t p = 0; p < mesh.primitives.size(); ++p) {
-            const Primitive& prim = mesh.primitives[p];
-            if (prim.indices.size() < 3)
-                continue;
-            state.draws.push_back({i, inst.mesh, p, vertex_count, triangle_count, mirrored,
-                                   materialOf(scene, prim).double_sided, normal_matrix});
-            vertex_count += uint32_t(prim.positions.size());
-            triangle_count += prim.indices.size() / 3;
+void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryState& state,
+                 bool keep_world) {
+    FOCAL_CHECK(!keep_world || state.world_scene == &scene);
+    if (!keep_world) {
+        state.world_scene = nullptr; // until the vertex pass below has run
+        // List the draws in submission order: instances, then their primitives.
+        state.draws.clear();
+        uint32_t vertex_count = 0;
+        uint64_t triangle_count = 0;
+        for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+            const Instance& inst = scene.instances[i];
+            const Mesh& mesh = scene.meshes[inst.mesh];
+            const glm::mat3 linear(inst.world);
+            const bool mirrored = glm::determinant(linear) < 0.0f;
+            const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
+            for (uint32_t p = 0; p < mesh.primitives.size(); ++p) {
+                const Primitive& prim = mesh.primitives[p];
+                if (prim.indices.size() < 3)
+                    continue;
+                state.draws.push_back({i, inst.mesh, p, vertex_count, triangle_count, mirrored,
+                                       materialOf(scene, prim).double_sided, normal_matrix});
+                vertex_count += uint32_t(prim.positions.size());
+                triangle_count += prim.indices.size() / 3;
+            }
         }
+        state.vertices.resize(vertex_count);
+        state.world_w.resize(vertex_count);
+        state.triangle_count = triangle_count;
     }
+    const uint32_t vertex_count = uint32_t(state.vertices.size());
+    const uint64_t triangle_count = state.triangle_count;
     state.eye = view.eye + view.lens_offset.x * view.right + view.lens_offset.y * view.up;
 
     // Vertex transform, clip codes and viewport transform, in blocks of vertices.
-    state.vertices.resize(vertex_count);
     state.codes.resize(vertex_count);
     state.screen.resize(vertex_count);
     const float half_w = 0.5f * float(view.width), half_h = 0.5f * float(view.height);
@@ -257,20 +266,25 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
                                    [](uint32_t v, const Draw& d) { return v < d.first_vertex; });
         size_t d = size_t(it - state.draws.begin()) - 1;
         for (uint32_t vi = begin; vi < end; ++vi) {
-            while (d + 1 < state.draws.size() && state.draws[d + 1].first_vertex <= vi)
-                ++d;
-            const Draw& draw = state.draws[d];
-            const Instance& inst = scene.instances[draw.instance];
-            const Primitive& prim = scene.meshes[draw.mesh].primitives[draw.primitive];
-            const uint32_t local = vi - draw.first_vertex;
             ShadeVertex& out = state.vertices[vi];
-            const glm::vec4 world = inst.world * glm::vec4(prim.positions[local], 1.0f);
-            out.world = glm::vec3(world);
-            out.clip = view_proj * world;
-            out.normal =
-                prim.normals.empty() ? glm::vec3(0.0f) : draw.normal_matrix * prim.normals[local];
-            out.uv = prim.texcoords0.empty() ? glm::vec2(0.0f) : prim.texcoords0[local];
-            out.color = prim.colors.empty() ? glm::vec4(1.0f) : prim.colors[local];
+            if (keep_world) {
+                out.clip = view_proj * glm::vec4(out.world, state.world_w[vi]);
+            } else {
+                while (d + 1 < state.draws.size() && state.draws[d + 1].first_vertex <= vi)
+                    ++d;
+                const Draw& draw = state.draws[d];
+                const Instance& inst = scene.instances[draw.instance];
+                const Primitive& prim = scene.meshes[draw.mesh].primitives[draw.primitive];
+                const uint32_t local = vi - draw.first_vertex;
+                const glm::vec4 world = inst.world * glm::vec4(prim.positions[local], 1.0f);
+                out.world = glm::vec3(world);
+                state.world_w[vi] = world.w;
+                out.clip = view_proj * world;
+                out.normal = prim.normals.empty() ? glm::vec3(0.0f)
+                                                  : draw.normal_matrix * prim.normals[local];
+                out.uv = prim.texcoords0.empty() ? glm::vec2(0.0f) : prim.texcoords0[local];
+                out.color = prim.colors.empty() ? glm::vec4(1.0f) : prim.colors[local];
+            }
             VertexCodes& code = state.codes[vi];
             const glm::vec4& c = out.clip;
             code.finite = std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) &&
@@ -281,6 +295,7 @@ void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryS
                 state.screen[vi] = toScreen(c, half_w, half_h);
         }
     });
+    state.world_scene = &scene;
 
     // Assemble, clip, cull and set up, in chunks of kTrianglesPerChunk source triangles.
     const uint32_t chunk_count =

@@ -102,6 +102,14 @@ struct GeometryState {
     std::vector<ScreenVertex> screen;  // one per vertex; valid where codes.guard == 0
     std::vector<GeometryChunk> chunks;
     glm::vec3 eye{0.0f}; // the eye shading uses (moved by the lens offset)
+    // What does not depend on the view: the draws, and per vertex its world position, normal,
+    // uv and colour (in `vertices`) and the world position's w (1 for an affine instance
+    // transform of a finite position), from which a later view's clip position is computed
+    // with the same bits. `world_scene` is the scene they were made for (nullptr while they
+    // are being made).
+    std::vector<float> world_w;
+    uint64_t triangle_count = 0;
+    const Scene* world_scene = nullptr;
 
     const ShadeVertex& vertex(const GeometryChunk& chunk, uint32_t ref) const {
         return (ref & kClippedVertex) ? chunk.clipped_vertices[ref & ~kClippedVertex]
@@ -110,6 +118,10 @@ struct GeometryState {
 };
 
 // Runs the geometry stage for one view; fills state.draws, state.vertices and state.chunks.
-void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryState& state);
+// With keep_world (state.world_scene == &scene, and the caller knows the scene is unchanged
+// since), the view-independent part is kept and only the view's transform, clipping, culling
+// and set-up are run: the same state, bit for bit, as without it.
+void runGeometry(TaskPool& pool, const Scene& scene, const View& view, GeometryState& state,
+                 bool keep_world = false);
 
 } // namespace raster

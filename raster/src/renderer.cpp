@@ -137,7 +137,10 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     if (Status s = validateTextures(scene, options.shading); !s.ok())
         return s;
     State& st = *state_;
-    const bool reuse = scene_unchanged && st.made.prepared && st.made.scene == &scene &&
+    // Promised and the same scene: its world-space vertices are kept; and from the same view
+    // with the same tiles, the whole geometry and bins.
+    const bool keep_world = scene_unchanged && st.geometry.world_scene == &scene;
+    const bool reuse = keep_world && st.made.prepared && st.made.scene == &scene &&
                        st.made.view == view && st.made.tile_size == options.tile_size;
     st.ctx = RasterContext{};
     st.ctx.grid = makeTileGrid(view.width, view.height, options.tile_size);
@@ -145,7 +148,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     if (!reuse) {
         st.made.prepared = false; // until both are complete
         auto t0 = std::chrono::steady_clock::now();
-        runGeometry(pool_, scene, view, st.geometry);
+        runGeometry(pool_, scene, view, st.geometry, keep_world);
         ms_geometry = msSince(t0);
         t0 = std::chrono::steady_clock::now();
         binChunks(pool_, st.geometry, st.ctx.grid, st.bins);

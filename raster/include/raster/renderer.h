@@ -109,7 +109,10 @@ public:
     // call's, instead of making them again: the caller promises that the scene has not changed
     // since that call, which the Renderer cannot see. For a caller that renders one scene twice
     // from the same eye, as multiview renders a pinhole and then its layers (Lee et al. §4.1,
-    // §4.2). The promise holds for the next call only.
+    // §4.2). From another view of the same scene it keeps what does not depend on the view
+    // (the draws, and each vertex's world position, normal, uv and colour) and makes the rest
+    // again: accum's views (Haeberli & Akeley). Either way the bytes are a fresh render's. The
+    // promise holds for the next call only.
     void promiseSceneUnchanged();
 
     // Triangles binned to each tile by the last render call (any kind), summed over the geometry

@@ -268,6 +268,35 @@ TEST(LayeredTarget, GeometryIsKeptOnlyWhenPromisedForTheSameSceneAndView) {
     EXPECT_EQ(hashLayers(out), hashLayers(layers(s, v, desc)));
 }
 
+// A promise for another view of the same scene (accum's views) keeps the world-space vertices
+// and makes the rest again: the bytes of a fresh render of that view, at 0 and 2 threads, for
+// moved eyes, sheared lens views, and an instance whose transform is not affine (its world w is
+// not 1: a clip position made from (world, 1) would differ).
+TEST(Renderer, PromisedSceneKeepsItsWorldVerticesForAnotherView) {
+    for (const char* name : {"demo", "foliage"}) {
+        raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(name);
+        ASSERT_TRUE(scene.ok()) << name;
+        scene->instances[0].world[0][3] = 0.01f; // projective: w = 1 + 0.01 x
+        const raster::View v = raster::viewFromCamera(scene->cameras[0], 96, 64);
+        raster::View moved = v;
+        moved.eye.x += 0.2f;
+        raster::View sheared = v;
+        sheared.lens_offset = {0.05f, -0.03f};
+        for (uint32_t threads : {0u, 2u}) {
+            raster::TaskPool pool(threads);
+            raster::Renderer r(pool);
+            raster::Frame f;
+            ASSERT_TRUE(r.render(*scene, v, {}, f).ok());
+            for (const raster::View& next : {moved, sheared, v}) {
+                r.promiseSceneUnchanged();
+                ASSERT_TRUE(r.render(*scene, next, {}, f).ok());
+                EXPECT_EQ(hashFrame(f), hashFrame(render(*scene, next, {}, threads)))
+                    << name << ", " << threads << " threads";
+            }
+        }
+    }
+}
+
 TEST(LayeredTarget, InvalidBoundsAreErrors) {
     raster::TaskPool pool(0);
     raster::Renderer r(pool);
