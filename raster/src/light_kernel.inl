@@ -22,48 +22,61 @@ inline int32_t asInt(float f) {
     return __builtin_bit_cast(int32_t, f);
 }
 
+// The powers of J lights at once, each the same operations in the same order as for one: the
+// J dependency chains (about 40 steps of log2, exp2 and their divisions) are written step by
+// step side by side, so the core works on J of them at a time instead of waiting on one.
+
 // log2(x) for normal x > 0: x = m 2^e with m in [sqrt(1/2), sqrt(2)), then
 // log2(m) = 2/ln2 * atanh(t), t = (m-1)/(m+1), |t| < 0.172: five odd terms give ~1e-8.
-inline float log2Positive(float x) {
-    const int32_t bits = asInt(x);
-    int32_t e = ((bits >> 23) & 0xff) - 127;
-    float m = asFloat((bits & 0x007fffff) | 0x3f800000); // [1, 2)
-    const bool high = m > 1.41421356f;
-    m = high ? m * 0.5f : m;
-    e = high ? e + 1 : e;
-    const float t = (m - 1.0f) / (m + 1.0f);
-    const float t2 = t * t;
-    const float series =
-        t * (1.0f + t2 * (1.0f / 3.0f + t2 * (1.0f / 5.0f + t2 * (1.0f / 7.0f + t2 / 9.0f))));
-    return float(e) + series * 2.88539008f; // 2/ln(2)
+template <int J> inline void log2Positive(const float (&x)[J], float (&out)[J]) {
+    int32_t e[J];
+    float t[J], t2[J], q[J];
+    for (int j = 0; j < J; ++j) {
+        const int32_t bits = asInt(x[j]);
+        const float m = asFloat((bits & 0x007fffff) | 0x3f800000); // [1, 2)
+        const bool high = m > 1.41421356f;
+        const float mh = high ? m * 0.5f : m;
+        e[j] = ((bits >> 23) & 0xff) - 127 + (high ? 1 : 0);
+        t[j] = (mh - 1.0f) / (mh + 1.0f);
+    }
+    // t * (1 + t2 (1/3 + t2 (1/5 + t2 (1/7 + t2/9)))), innermost first.
+    for (int j = 0; j < J; ++j)
+        t2[j] = t[j] * t[j];
+    for (int j = 0; j < J; ++j)
+        q[j] = t2[j] / 9.0f;
+    for (const float c : {1.0f / 7.0f, 1.0f / 5.0f, 1.0f / 3.0f}) {
+        for (int j = 0; j < J; ++j)
+            q[j] = c + q[j];
+        for (int j = 0; j < J; ++j)
+            q[j] = t2[j] * q[j];
+    }
+    for (int j = 0; j < J; ++j)
+        out[j] = float(e[j]) + (t[j] * (1.0f + q[j])) * 2.88539008f; // 2/ln(2)
 }
 
 // 2^y for y <= 0: y = n + f with n = trunc(y) and f in (-1, 0]; 2^f by its Taylor series in
 // f*ln2 to the 9th power (~1e-8 relative); 2^n by building the exponent bits. Below -127 the
 // exponent field is 0 and the result is 0.
-inline float exp2NonPositive(float y) {
-    const float yc = y > -127.0f ? y : -127.0f;
-    const int32_t n = int32_t(yc);
-    const float f = (yc - float(n)) * 0.693147181f;
-    const float p =
-        1.0f +
-        f * (1.0f +
-             f * (1.0f / 2.0f +
-                  f * (1.0f / 6.0f +
-                       f * (1.0f / 24.0f +
-                            f * (1.0f / 120.0f +
-                                 f * (1.0f / 720.0f +
-                                      f * (1.0f / 5040.0f +
-                                           f * (1.0f / 40320.0f + f * (1.0f / 362880.0f)))))))));
-    return p * asFloat((n + 127) << 23);
-}
-
-// x^s for x in [0, 1] and s >= 0; 0^s = 0. (x + 1e-30 is x itself for every x the lighting
-// produces above 1e-30, and keeps log2 finite at 0; the product with 0 or 1, rather than a
-// select, keeps the compiler from turning the pow into a branch.)
-inline float powUnit(float x, float s) {
-    const float r = exp2NonPositive(s * log2Positive(x + 1e-30f));
-    return r * (x > 0.0f ? 1.0f : 0.0f);
+template <int J> inline void exp2NonPositive(const float (&y)[J], float (&out)[J]) {
+    int32_t n[J];
+    float f[J], p[J];
+    for (int j = 0; j < J; ++j) {
+        const float yc = y[j] > -127.0f ? y[j] : -127.0f;
+        n[j] = int32_t(yc);
+        f[j] = (yc - float(n[j])) * 0.693147181f;
+    }
+    // 1 + f (1 + f (1/2 + f (1/6 + ... + f (1/40320 + f/362880)))), innermost first.
+    for (int j = 0; j < J; ++j)
+        p[j] = f[j] * (1.0f / 362880.0f);
+    for (const float c : {1.0f / 40320.0f, 1.0f / 5040.0f, 1.0f / 720.0f, 1.0f / 120.0f,
+                          1.0f / 24.0f, 1.0f / 6.0f, 1.0f / 2.0f, 1.0f}) {
+        for (int j = 0; j < J; ++j)
+            p[j] = c + p[j];
+        for (int j = 0; j < J; ++j)
+            p[j] = f[j] * p[j];
+    }
+    for (int j = 0; j < J; ++j)
+        out[j] = (1.0f + p[j]) * asFloat((n[j] + 127) << 23);
 }
 
 } // namespace
@@ -109,28 +122,18 @@ void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* __restrict lights, uint32_t li
         io.rgb[1][l] = io.emissive[1][l] + kAmbient * io.albedo[1][l];
         io.rgb[2][l] = io.emissive[2][l] + kAmbient * io.albedo[2][l];
     }
-    // Adds one light's contribution at lane l: direction to the light (lx, ly, lz), unit, and
-    // the fraction of its radiance that arrives.
-    auto accumulate = [&](const PreparedLight& light, int l, float lx, float ly, float lz,
-                          float attenuation) {
-        const float n_dot_l = n[0][l] * lx + n[1][l] * ly + n[2][l] * lz;
-        const float hx = lx + v[0][l], hy = ly + v[1][l], hz = lz + v[2][l];
-        const float h2 = hx * hx + hy * hy + hz * hz;
-        const float inv_h = h2 > 0.0f ? 1.0f / __builtin_sqrtf(h2) : 0.0f;
-        const float ndh = (n[0][l] * hx + n[1][l] * hy + n[2][l] * hz) * inv_h;
-        const float n_dot_h = ndh > 0.0f ? (ndh < 1.0f ? ndh : 1.0f) : 0.0f;
-        const float spec = spec_norm * powUnit(n_dot_h, shininess);
-        const float k = n_dot_l > 0.0f ? n_dot_l * attenuation : 0.0f;
-        io.rgb[0][l] += (diffuse[0][l] + f0[0][l] * spec) * (light.radiance[0] * k);
-        io.rgb[1][l] += (diffuse[1][l] + f0[1][l] * spec) * (light.radiance[1] * k);
-        io.rgb[2][l] += (diffuse[2][l] + f0[2][l] * spec) * (light.radiance[2] * k);
-    };
-    for (uint32_t li = 0; li < light_count; ++li) {
-        const PreparedLight& L = lights[li];
+    // Where each light comes from at each lane (unit direction to it) and the fraction of its
+    // radiance that arrives: light j of the pair being shaded.
+    alignas(32) float to_light[2][3][kLightLanes], arriving[2][kLightLanes];
+    auto incidence = [&](const PreparedLight& L, int j) {
         if (L.type == Light::Type::Directional) {
-            for (int l = 0; l < n_lanes; ++l)
-                accumulate(L, l, -L.direction[0], -L.direction[1], -L.direction[2], 1.0f);
-            continue;
+            for (int l = 0; l < n_lanes; ++l) {
+                to_light[j][0][l] = -L.direction[0];
+                to_light[j][1][l] = -L.direction[1];
+                to_light[j][2][l] = -L.direction[2];
+                arriving[j][l] = 1.0f;
+            }
+            return;
         }
         // Point and spot lights (a point light's cone constants make the cone factor 1).
         for (int l = 0; l < n_lanes; ++l) {
@@ -140,6 +143,9 @@ void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* __restrict lights, uint32_t li
             const float dist2 = d2raw > 1e-8f ? d2raw : 1e-8f;
             const float inv_d = 1.0f / __builtin_sqrtf(dist2);
             const float lx = tx * inv_d, ly = ty * inv_d, lz = tz * inv_d;
+            to_light[j][0][l] = lx;
+            to_light[j][1][l] = ly;
+            to_light[j][2][l] = lz;
             // KHR_lights_punctual: inverse square with a smooth window at `range`, and the
             // spot cone's smooth falloff, squared.
             const float rr = dist2 * L.inv_range2;
@@ -147,9 +153,48 @@ void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* __restrict lights, uint32_t li
             const float cd = -(L.direction[0] * lx + L.direction[1] * ly + L.direction[2] * lz);
             const float tc = (cd - L.cos_outer) * L.inv_cone_width;
             const float cone = tc < 0.0f ? 0.0f : (tc > 1.0f ? 1.0f : tc);
-            const float attenuation =
-                (1.0f / dist2) * (window < 0.0f ? 0.0f : window) * (cone * cone);
-            accumulate(L, l, lx, ly, lz, attenuation);
+            arriving[j][l] = (1.0f / dist2) * (window < 0.0f ? 0.0f : window) * (cone * cone);
         }
+    };
+    // Adds the contributions of lights[first .. first + J) (their incidence filled), in light
+    // order at every lane. The specular power (n.h)^s is exp2(s log2(n.h + 1e-30)) times
+    // (n.h > 0): n.h + 1e-30 is n.h itself above 1e-30 and keeps log2 finite at 0, and the
+    // product with 0 or 1, rather than a select, keeps the compiler from making it a branch.
+    auto shadeLights = [&]<int J>(uint32_t first) {
+        for (int l = 0; l < n_lanes; ++l) {
+            float n_dot_l[J], n_dot_h[J], x[J], y[J], power[J];
+            for (int j = 0; j < J; ++j) {
+                const float lx = to_light[j][0][l], ly = to_light[j][1][l], lz = to_light[j][2][l];
+                n_dot_l[j] = n[0][l] * lx + n[1][l] * ly + n[2][l] * lz;
+                const float hx = lx + v[0][l], hy = ly + v[1][l], hz = lz + v[2][l];
+                const float h2 = hx * hx + hy * hy + hz * hz;
+                const float inv_h = h2 > 0.0f ? 1.0f / __builtin_sqrtf(h2) : 0.0f;
+                const float ndh = (n[0][l] * hx + n[1][l] * hy + n[2][l] * hz) * inv_h;
+                n_dot_h[j] = ndh > 0.0f ? (ndh < 1.0f ? ndh : 1.0f) : 0.0f;
+                x[j] = n_dot_h[j] + 1e-30f;
+            }
+            log2Positive<J>(x, y);
+            for (int j = 0; j < J; ++j)
+                y[j] = shininess * y[j];
+            exp2NonPositive<J>(y, power);
+            for (int j = 0; j < J; ++j) {
+                const PreparedLight& L = lights[first + j];
+                const float spec = spec_norm * (power[j] * (n_dot_h[j] > 0.0f ? 1.0f : 0.0f));
+                const float k = n_dot_l[j] > 0.0f ? n_dot_l[j] * arriving[j][l] : 0.0f;
+                io.rgb[0][l] += (diffuse[0][l] + f0[0][l] * spec) * (L.radiance[0] * k);
+                io.rgb[1][l] += (diffuse[1][l] + f0[1][l] * spec) * (L.radiance[1] * k);
+                io.rgb[2][l] += (diffuse[2][l] + f0[2][l] * spec) * (L.radiance[2] * k);
+            }
+        }
+    };
+    uint32_t li = 0;
+    for (; li + 2 <= light_count; li += 2) {
+        incidence(lights[li], 0);
+        incidence(lights[li + 1], 1);
+        shadeLights.template operator()<2>(li);
+    }
+    if (li < light_count) {
+        incidence(lights[li], 0);
+        shadeLights.template operator()<1>(li);
     }
 }
