@@ -79,111 +79,128 @@ template <int J> inline void exp2NonPositive(const float (&y)[J], float (&out)[J
         out[j] = (1.0f + p[j]) * asFloat((n[j] + 127) << 23);
 }
 
-} // namespace
+// What the lanes share: the material's lighting constants.
+struct MaterialTerms {
+    float metallic, shininess, spec_norm, diffuse_scale;
+};
 
-// __restrict: io never overlaps the lights, the material or the eye, which lets the lane loops
-// keep the light constants in registers.
-void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* __restrict lights, uint32_t light_count,
-                             const LightMaterial& __restrict material, const float* __restrict eye,
-                             LightLanes& __restrict io, int lanes) {
-    const int n_lanes = FOCAL_LIGHT_KERNEL_FULL_WIDTH ? kLightLanes : lanes;
-    const float metallic = material.metallic < 0.0f   ? 0.0f
-                           : material.metallic > 1.0f ? 1.0f
-                                                      : material.metallic;
+MaterialTerms materialTerms(const LightMaterial& material) {
+    MaterialTerms t;
+    t.metallic = material.metallic < 0.0f   ? 0.0f
+                 : material.metallic > 1.0f ? 1.0f
+                                            : material.metallic;
     const float r2 = material.roughness * material.roughness;
     const float alpha = r2 > 0.02f ? r2 : 0.02f;
     // Blinn-Phong exponent matching a GGX-like lobe of roughness alpha (Walter et al. 2007).
-    const float shininess = 2.0f / (alpha * alpha) - 2.0f;
-    const float spec_norm = (shininess + 8.0f) / (8.0f * kPi);
-    const float diffuse_scale = (1.0f - metallic) * (1.0f / kPi);
+    t.shininess = 2.0f / (alpha * alpha) - 2.0f;
+    t.spec_norm = (t.shininess + 8.0f) / (8.0f * kPi);
+    t.diffuse_scale = (1.0f - t.metallic) * (1.0f / kPi);
+    return t;
+}
 
-    alignas(32) float n[3][kLightLanes], v[3][kLightLanes], diffuse[3][kLightLanes],
-        f0[3][kLightLanes];
-    for (int l = 0; l < n_lanes; ++l) {
-        const float nx = io.normal[0][l], ny = io.normal[1][l], nz = io.normal[2][l];
-        const float len2 = nx * nx + ny * ny + nz * nz;
-        const float inv_len = len2 > 0.0f ? 1.0f / __builtin_sqrtf(len2) : 0.0f;
-        n[0][l] = len2 > 0.0f ? nx * inv_len : 0.0f;
-        n[1][l] = len2 > 0.0f ? ny * inv_len : 0.0f;
-        n[2][l] = len2 > 0.0f ? nz * inv_len : 1.0f;
-        const float vx = eye[0] - io.world[0][l], vy = eye[1] - io.world[1][l],
-                    vz = eye[2] - io.world[2][l];
-        const float inv_v = 1.0f / __builtin_sqrtf(vx * vx + vy * vy + vz * vz);
-        v[0][l] = vx * inv_v;
-        v[1][l] = vy * inv_v;
-        v[2][l] = vz * inv_v;
-        diffuse[0][l] = io.albedo[0][l] * diffuse_scale;
-        diffuse[1][l] = io.albedo[1][l] * diffuse_scale;
-        diffuse[2][l] = io.albedo[2][l] * diffuse_scale;
-        f0[0][l] = 0.04f + (io.albedo[0][l] - 0.04f) * metallic;
-        f0[1][l] = 0.04f + (io.albedo[1][l] - 0.04f) * metallic;
-        f0[2][l] = 0.04f + (io.albedo[2][l] - 0.04f) * metallic;
-        io.rgb[0][l] = io.emissive[0][l] + kAmbient * io.albedo[0][l];
-        io.rgb[1][l] = io.emissive[1][l] + kAmbient * io.albedo[1][l];
-        io.rgb[2][l] = io.emissive[2][l] + kAmbient * io.albedo[2][l];
-    }
+// Shades lanes [0, width) of the G blocks io[0 .. G). With G = 2 every step of a light is
+// written for both blocks side by side, as for two lights (log2Positive): the core then has
+// twice the independent chains to work on. __restrict: io never overlaps the lights or the eye,
+// which lets the lane loops keep the light constants in registers.
+template <int G>
+void shadeBlocks(const PreparedLight* __restrict lights, uint32_t light_count,
+                 const MaterialTerms& mt, const float* __restrict eye, LightLanes* __restrict io,
+                 int width) {
+    alignas(32) float n[G][3][kLightLanes], v[G][3][kLightLanes], diffuse[G][3][kLightLanes],
+        f0[G][3][kLightLanes];
+    for (int g = 0; g < G; ++g)
+        for (int l = 0; l < width; ++l) {
+            LightLanes& b = io[g];
+            const float nx = b.normal[0][l], ny = b.normal[1][l], nz = b.normal[2][l];
+            const float len2 = nx * nx + ny * ny + nz * nz;
+            const float inv_len = len2 > 0.0f ? 1.0f / __builtin_sqrtf(len2) : 0.0f;
+            n[g][0][l] = len2 > 0.0f ? nx * inv_len : 0.0f;
+            n[g][1][l] = len2 > 0.0f ? ny * inv_len : 0.0f;
+            n[g][2][l] = len2 > 0.0f ? nz * inv_len : 1.0f;
+            const float vx = eye[0] - b.world[0][l], vy = eye[1] - b.world[1][l],
+                        vz = eye[2] - b.world[2][l];
+            const float inv_v = 1.0f / __builtin_sqrtf(vx * vx + vy * vy + vz * vz);
+            v[g][0][l] = vx * inv_v;
+            v[g][1][l] = vy * inv_v;
+            v[g][2][l] = vz * inv_v;
+            for (int c = 0; c < 3; ++c) {
+                diffuse[g][c][l] = b.albedo[c][l] * mt.diffuse_scale;
+                f0[g][c][l] = 0.04f + (b.albedo[c][l] - 0.04f) * mt.metallic;
+                b.rgb[c][l] = b.emissive[c][l] + kAmbient * b.albedo[c][l];
+            }
+        }
     // Where each light comes from at each lane (unit direction to it) and the fraction of its
     // radiance that arrives: light j of the pair being shaded.
-    alignas(32) float to_light[2][3][kLightLanes], arriving[2][kLightLanes];
+    alignas(32) float to_light[2][G][3][kLightLanes], arriving[2][G][kLightLanes];
     auto incidence = [&](const PreparedLight& L, int j) {
-        if (L.type == Light::Type::Directional) {
-            for (int l = 0; l < n_lanes; ++l) {
-                to_light[j][0][l] = -L.direction[0];
-                to_light[j][1][l] = -L.direction[1];
-                to_light[j][2][l] = -L.direction[2];
-                arriving[j][l] = 1.0f;
+        for (int g = 0; g < G; ++g) {
+            if (L.type == Light::Type::Directional) {
+                for (int l = 0; l < width; ++l) {
+                    to_light[j][g][0][l] = -L.direction[0];
+                    to_light[j][g][1][l] = -L.direction[1];
+                    to_light[j][g][2][l] = -L.direction[2];
+                    arriving[j][g][l] = 1.0f;
+                }
+                continue;
             }
-            return;
-        }
-        // Point and spot lights (a point light's cone constants make the cone factor 1).
-        for (int l = 0; l < n_lanes; ++l) {
-            const float tx = L.position[0] - io.world[0][l], ty = L.position[1] - io.world[1][l],
-                        tz = L.position[2] - io.world[2][l];
-            const float d2raw = tx * tx + ty * ty + tz * tz;
-            const float dist2 = d2raw > 1e-8f ? d2raw : 1e-8f;
-            const float inv_d = 1.0f / __builtin_sqrtf(dist2);
-            const float lx = tx * inv_d, ly = ty * inv_d, lz = tz * inv_d;
-            to_light[j][0][l] = lx;
-            to_light[j][1][l] = ly;
-            to_light[j][2][l] = lz;
-            // KHR_lights_punctual: inverse square with a smooth window at `range`, and the
-            // spot cone's smooth falloff, squared.
-            const float rr = dist2 * L.inv_range2;
-            const float window = 1.0f - rr * rr;
-            const float cd = -(L.direction[0] * lx + L.direction[1] * ly + L.direction[2] * lz);
-            const float tc = (cd - L.cos_outer) * L.inv_cone_width;
-            const float cone = tc < 0.0f ? 0.0f : (tc > 1.0f ? 1.0f : tc);
-            arriving[j][l] = (1.0f / dist2) * (window < 0.0f ? 0.0f : window) * (cone * cone);
+            // Point and spot lights (a point light's cone constants make the cone factor 1).
+            const LightLanes& b = io[g];
+            for (int l = 0; l < width; ++l) {
+                const float tx = L.position[0] - b.world[0][l], ty = L.position[1] - b.world[1][l],
+                            tz = L.position[2] - b.world[2][l];
+                const float d2raw = tx * tx + ty * ty + tz * tz;
+                const float dist2 = d2raw > 1e-8f ? d2raw : 1e-8f;
+                const float inv_d = 1.0f / __builtin_sqrtf(dist2);
+                const float lx = tx * inv_d, ly = ty * inv_d, lz = tz * inv_d;
+                to_light[j][g][0][l] = lx;
+                to_light[j][g][1][l] = ly;
+                to_light[j][g][2][l] = lz;
+                // KHR_lights_punctual: inverse square with a smooth window at `range`, and the
+                // spot cone's smooth falloff, squared.
+                const float rr = dist2 * L.inv_range2;
+                const float window = 1.0f - rr * rr;
+                const float cd = -(L.direction[0] * lx + L.direction[1] * ly + L.direction[2] * lz);
+                const float tc = (cd - L.cos_outer) * L.inv_cone_width;
+                const float cone = tc < 0.0f ? 0.0f : (tc > 1.0f ? 1.0f : tc);
+                arriving[j][g][l] =
+                    (1.0f / dist2) * (window < 0.0f ? 0.0f : window) * (cone * cone);
+            }
         }
     };
     // Adds the contributions of lights[first .. first + J) (their incidence filled), in light
-    // order at every lane. The specular power (n.h)^s is exp2(s log2(n.h + 1e-30)) times
-    // (n.h > 0): n.h + 1e-30 is n.h itself above 1e-30 and keeps log2 finite at 0, and the
-    // product with 0 or 1, rather than a select, keeps the compiler from making it a branch.
+    // order at every lane: J x G chains (stream s: light s % J of block s / J) side by side.
+    // The specular power (n.h)^s is exp2(s log2(n.h + 1e-30)) times (n.h > 0): n.h + 1e-30 is
+    // n.h itself above 1e-30 and keeps log2 finite at 0, and the product with 0 or 1, rather
+    // than a select, keeps the compiler from making it a branch.
     auto shadeLights = [&]<int J>(uint32_t first) {
-        for (int l = 0; l < n_lanes; ++l) {
-            float n_dot_l[J], n_dot_h[J], x[J], y[J], power[J];
-            for (int j = 0; j < J; ++j) {
-                const float lx = to_light[j][0][l], ly = to_light[j][1][l], lz = to_light[j][2][l];
-                n_dot_l[j] = n[0][l] * lx + n[1][l] * ly + n[2][l] * lz;
-                const float hx = lx + v[0][l], hy = ly + v[1][l], hz = lz + v[2][l];
+        constexpr int S = J * G;
+        for (int l = 0; l < width; ++l) {
+            float n_dot_l[S], n_dot_h[S], x[S], y[S], power[S];
+            for (int s = 0; s < S; ++s) {
+                const int j = s % J, g = s / J;
+                const float lx = to_light[j][g][0][l], ly = to_light[j][g][1][l],
+                            lz = to_light[j][g][2][l];
+                const float nx = n[g][0][l], ny = n[g][1][l], nz = n[g][2][l];
+                n_dot_l[s] = nx * lx + ny * ly + nz * lz;
+                const float hx = lx + v[g][0][l], hy = ly + v[g][1][l], hz = lz + v[g][2][l];
                 const float h2 = hx * hx + hy * hy + hz * hz;
                 const float inv_h = h2 > 0.0f ? 1.0f / __builtin_sqrtf(h2) : 0.0f;
-                const float ndh = (n[0][l] * hx + n[1][l] * hy + n[2][l] * hz) * inv_h;
-                n_dot_h[j] = ndh > 0.0f ? (ndh < 1.0f ? ndh : 1.0f) : 0.0f;
-                x[j] = n_dot_h[j] + 1e-30f;
+                const float ndh = (nx * hx + ny * hy + nz * hz) * inv_h;
+                n_dot_h[s] = ndh > 0.0f ? (ndh < 1.0f ? ndh : 1.0f) : 0.0f;
+                x[s] = n_dot_h[s] + 1e-30f;
             }
-            log2Positive<J>(x, y);
-            for (int j = 0; j < J; ++j)
-                y[j] = shininess * y[j];
-            exp2NonPositive<J>(y, power);
-            for (int j = 0; j < J; ++j) {
+            log2Positive<S>(x, y);
+            for (int s = 0; s < S; ++s)
+                y[s] = mt.shininess * y[s];
+            exp2NonPositive<S>(y, power);
+            for (int s = 0; s < S; ++s) {
+                const int j = s % J, g = s / J;
                 const PreparedLight& L = lights[first + j];
-                const float spec = spec_norm * (power[j] * (n_dot_h[j] > 0.0f ? 1.0f : 0.0f));
-                const float k = n_dot_l[j] > 0.0f ? n_dot_l[j] * arriving[j][l] : 0.0f;
-                io.rgb[0][l] += (diffuse[0][l] + f0[0][l] * spec) * (L.radiance[0] * k);
-                io.rgb[1][l] += (diffuse[1][l] + f0[1][l] * spec) * (L.radiance[1] * k);
-                io.rgb[2][l] += (diffuse[2][l] + f0[2][l] * spec) * (L.radiance[2] * k);
+                const float spec = mt.spec_norm * (power[s] * (n_dot_h[s] > 0.0f ? 1.0f : 0.0f));
+                const float k = n_dot_l[s] > 0.0f ? n_dot_l[s] * arriving[j][g][l] : 0.0f;
+                for (int c = 0; c < 3; ++c)
+                    io[g].rgb[c][l] +=
+                        (diffuse[g][c][l] + f0[g][c][l] * spec) * (L.radiance[c] * k);
             }
         }
     };
@@ -197,4 +214,22 @@ void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* __restrict lights, uint32_t li
         incidence(lights[li], 0);
         shadeLights.template operator()<1>(li);
     }
+}
+
+} // namespace
+
+void FOCAL_LIGHT_KERNEL_NAME(const PreparedLight* lights, uint32_t light_count,
+                             const LightMaterial& material, const float* eye, LightLanes* io,
+                             int blocks, int lanes) {
+    const MaterialTerms mt = materialTerms(material);
+#if FOCAL_LIGHT_KERNEL_FULL_WIDTH
+    (void)lanes;
+    if (blocks == 2)
+        shadeBlocks<2>(lights, light_count, mt, eye, io, kLightLanes);
+    else
+        shadeBlocks<1>(lights, light_count, mt, eye, io, kLightLanes);
+#else
+    for (int b = 0; b < blocks; ++b)
+        shadeBlocks<1>(lights, light_count, mt, eye, io + b, b + 1 == blocks ? lanes : kLightLanes);
+#endif
 }

@@ -131,7 +131,7 @@ glm::vec3 shadeSample(const ShadeContext& ctx, const GSample& g, glm::vec3 world
         lanes.normal[c][0] = g.normal[c];
     }
     const float eye3[3] = {eye.x, eye.y, eye.z};
-    ctx.light_kernel(ctx.lights, ctx.light_count, {g.metallic, g.roughness}, eye3, lanes, 1);
+    ctx.light_kernel(ctx.lights, ctx.light_count, {g.metallic, g.roughness}, eye3, &lanes, 1, 1);
     return {lanes.rgb[0][0], lanes.rgb[1][0], lanes.rgb[2][0]};
 }
 

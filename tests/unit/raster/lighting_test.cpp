@@ -60,7 +60,7 @@ TEST(Lighting, KernelMatchesTheModel) {
             io.world[c][0] = unit() - 0.5f;
             io.normal[c][0] = 2.0f * unit() - 1.0f;
         }
-        raster::lightKernelScalar(lights.data(), uint32_t(lights.size()), m, eye, io, 1);
+        raster::lightKernelScalar(lights.data(), uint32_t(lights.size()), m, eye, &io, 1, 1);
         const glm::dvec3 e =
             reference(scene.lights, {io.albedo[0][0], io.albedo[1][0], io.albedo[2][0]}, m.metallic,
                       m.roughness, {io.normal[0][0], io.normal[1][0], io.normal[2][0]},

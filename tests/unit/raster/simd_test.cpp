@@ -84,23 +84,31 @@ TEST(Simd, LightKernelMatchesScalarBitForBit) {
     raster::prepareLights(scene, glm::vec3(0.0f, -1.0f, 0.0f), lights);
     const float eye[3] = {0.0f, 1.0f, 5.0f};
     for (int i = 0; i < 5000; ++i) {
-        raster::LightLanes a;
-        for (int c = 0; c < 3; ++c)
-            for (int l = 0; l < raster::kLightLanes; ++l) {
-                a.albedo[c][l] = unit();
-                a.emissive[c][l] = unit() < 0.2f ? 4.0f * unit() : 0.0f;
-                a.world[c][l] = 4.0f * unit() - 2.0f;
-                a.normal[c][l] = 2.0f * unit() - 1.0f;
-            }
-        raster::LightLanes b = a;
+        // One block, or two (whose chains the AVX2 build interleaves), the last one partial.
+        raster::LightLanes a[2];
+        for (raster::LightLanes& block : a)
+            for (int c = 0; c < 3; ++c)
+                for (int l = 0; l < raster::kLightLanes; ++l) {
+                    block.albedo[c][l] = unit();
+                    block.emissive[c][l] = unit() < 0.2f ? 4.0f * unit() : 0.0f;
+                    block.world[c][l] = 4.0f * unit() - 2.0f;
+                    block.normal[c][l] = 2.0f * unit() - 1.0f;
+                }
+        raster::LightLanes b[2] = {a[0], a[1]};
         const raster::LightMaterial m{unit(), unit()};
-        const int lanes = 1 + i % raster::kLightLanes;
-        raster::lightKernelScalar(lights.data(), uint32_t(lights.size()), m, eye, a, lanes);
-        wide(lights.data(), uint32_t(lights.size()), m, eye, b, lanes);
-        for (int c = 0; c < 3; ++c)
-            for (int l = 0; l < lanes; ++l)
-                ASSERT_EQ(std::memcmp(&a.rgb[c][l], &b.rgb[c][l], sizeof(float)), 0)
-                    << i << " lane " << l << ": " << a.rgb[c][l] << " vs " << b.rgb[c][l];
+        const int blocks = 1 + i % 2;
+        const int lanes = 1 + (i / 2) % raster::kLightLanes;
+        // Every light type, and the lights in pairs and alone.
+        const uint32_t count = 1 + uint32_t(i / 16) % uint32_t(lights.size());
+        const raster::PreparedLight* first = lights.data() + (i / 48) % (lights.size() - count + 1);
+        raster::lightKernelScalar(first, count, m, eye, a, blocks, lanes);
+        wide(first, count, m, eye, b, blocks, lanes);
+        for (int k = 0; k < blocks; ++k)
+            for (int c = 0; c < 3; ++c)
+                for (int l = 0; l < (k + 1 == blocks ? lanes : raster::kLightLanes); ++l)
+                    ASSERT_EQ(std::memcmp(&a[k].rgb[c][l], &b[k].rgb[c][l], sizeof(float)), 0)
+                        << i << " block " << k << " lane " << l << ": " << a[k].rgb[c][l] << " vs "
+                        << b[k].rgb[c][l];
     }
 }
 
