@@ -102,6 +102,61 @@ TEST(Depth, QueuedLitLanesKeepPrimitiveOrder) {
     EXPECT_EQ(centre({{green, 60.0f}, {red, 64.0f}}), alone);
 }
 
+// The same with pairs of five or more lit lanes, which the fragment kernel writes into whole
+// blocks of the queue, mixed with packed lanes of small triangles: a pixel queued twice ends with
+// its later triangle's colour whichever way each was queued.
+TEST(Depth, QueuedWholeBlocksKeepPrimitiveOrder) {
+    raster::Material red = flatMaterial({1, 0, 0, 1}), green = flatMaterial({0, 1, 0, 1});
+    red.unlit = green.unlit = false; // the same lighting constants: one queue
+    const std::vector<uint32_t> tri = {0, 1, 2};
+    // At depth d: about two pixels around the centre pixel (32, 32), or five of the eight
+    // pixels of its quad pair (x 32-35, y 32-33) and no other pixel, so that two of them queued
+    // one after the other share a batch.
+    auto triangleAt = [](float d, bool pair) {
+        const float k = d / kDist;
+        if (pair)
+            return std::vector<glm::vec3>{
+                {0.02f * k, 0.02f * k, -d}, {4.4f * k, 0.02f * k, -d}, {0.02f * k, -2.3f * k, -d}};
+        return std::vector<glm::vec3>{
+            {-0.2f * k, -1.2f * k, -d}, {1.8f * k, -1.2f * k, -d}, {0.8f * k, 0.9f * k, -d}};
+    };
+    struct Drawn {
+        raster::Material m;
+        float d;
+        bool pair;
+    };
+    auto centre = [&](std::vector<Drawn> drawn) {
+        raster::Scene s;
+        for (const Drawn& t : drawn)
+            addMesh(s, triangleAt(t.d, t.pair), tri, addMaterial(s, t.m));
+        raster::FrameStats stats;
+        const raster::Frame f = render(s, pixelView(kSize, kSize, kDist), {}, 0, &stats);
+        if (drawn.size() == 1 && drawn[0].pair) {
+            EXPECT_EQ(stats.fragments_passed, 5u); // a whole block of the queue
+        }
+        return pixel(f, 32, 32);
+    };
+    for (const bool pair_green : {false, true}) {
+        const glm::vec4 alone = centre({{green, 60.0f, pair_green}});
+        EXPECT_GT(alone.g, 0.0f);
+        EXPECT_EQ(alone.r, 0.0f);
+        for (const bool pair_red : {false, true}) {
+            if (!pair_red && !pair_green)
+                continue; // Depth.QueuedLitLanesKeepPrimitiveOrder
+            EXPECT_EQ(centre({{red, 64.0f, pair_red}, {green, 60.0f, pair_green}}), alone)
+                << pair_red << pair_green;
+            EXPECT_EQ(centre({{green, 60.0f, pair_green}, {red, 64.0f, pair_red}}), alone)
+                << pair_red << pair_green;
+            // A red one behind, then green in front, then red again behind: still green.
+            EXPECT_EQ(
+                centre(
+                    {{red, 64.0f, pair_red}, {green, 60.0f, pair_green}, {red, 62.0f, pair_red}}),
+                alone)
+                << pair_red << pair_green;
+        }
+    }
+}
+
 TEST(Depth, StoredValuesMatchTheProjection) {
     for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm16}) {
         const raster::Frame f = renderTwoPlanes(100.0f, 200.0f, format);
