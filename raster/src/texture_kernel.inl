@@ -120,50 +120,62 @@ inline void fetchLanes(const TextureLevel& level, const float* lut, const int32_
             rgba[c][l] = float(int32_t((t[l] >> (8 * c)) & 0xffu)) * (1.0f / 255.0f);
 }
 
-// One level, nearest or bilinear, at every lane (texture.cpp's sampleLevel).
-inline void sampleLevelLanes(const TextureQuery& q, const TextureLevel& level, const float* u,
-                             const float* v, float (*rgba)[kLanes]) {
-    const double w = double(level.width), h = double(level.height);
-    alignas(32) int32_t ix[kLanes], iy[kLanes];
-    alignas(32) float ax[kLanes], ay[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-        const double x = texelCoordLane(u[l], w), y = texelCoordLane(v[l], h);
-        const double fx = __builtin_floor(q.nearest ? x + 0.5 : x);
-        const double fy = __builtin_floor(q.nearest ? y + 0.5 : y);
-        ax[l] = float(x - fx);
-        ay[l] = float(y - fy);
-        ix[l] = int32_t(fx);
-        iy[l] = int32_t(fy);
+// J levels (1, or the 2 of a trilinear lookup), nearest or bilinear, at every lane
+// (texture.cpp's sampleLevel on each). The levels' steps are written side by side, so that the
+// core works on both levels' chains (coordinates, wrap, index, loads, mixing) at once.
+template <int J>
+inline void sampleLevelLanes(const TextureQuery& q, const TextureLevel* const (&levels)[J],
+                             const float* u, const float* v, float (*const (&rgba)[J])[kLanes]) {
+    alignas(32) int32_t ix[J][kLanes], iy[J][kLanes];
+    alignas(32) float ax[J][kLanes], ay[J][kLanes];
+    for (int j = 0; j < J; ++j) {
+        const double w = double(levels[j]->width), h = double(levels[j]->height);
+        for (int l = 0; l < kLanes; ++l) {
+            const double x = texelCoordLane(u[l], w), y = texelCoordLane(v[l], h);
+            const double fx = __builtin_floor(q.nearest ? x + 0.5 : x);
+            const double fy = __builtin_floor(q.nearest ? y + 0.5 : y);
+            ax[j][l] = float(x - fx);
+            ay[j][l] = float(y - fy);
+            ix[j][l] = int32_t(fx);
+            iy[j][l] = int32_t(fy);
+        }
     }
-    alignas(32) int32_t x0[kLanes], x1[kLanes], y0[kLanes], y1[kLanes];
-    wrapLanes(ix, level.width, q.wrap_s, x0, x1);
-    wrapLanes(iy, level.height, q.wrap_t, y0, y1);
+    alignas(32) int32_t x0[J][kLanes], x1[J][kLanes], y0[J][kLanes], y1[J][kLanes];
+    for (int j = 0; j < J; ++j) {
+        wrapLanes(ix[j], levels[j]->width, q.wrap_s, x0[j], x1[j]);
+        wrapLanes(iy[j], levels[j]->height, q.wrap_t, y0[j], y1[j]);
+    }
     if (q.nearest) {
-        fetchLanes(level, q.srgb_lut, x0, y0, rgba);
+        for (int j = 0; j < J; ++j)
+            fetchLanes(*levels[j], q.srgb_lut, x0[j], y0[j], rgba[j]);
         return;
     }
-    alignas(32) float c00[4][kLanes], c10[4][kLanes], c01[4][kLanes], c11[4][kLanes];
-    fetchLanes(level, q.srgb_lut, x0, y0, c00);
-    fetchLanes(level, q.srgb_lut, x1, y0, c10);
-    fetchLanes(level, q.srgb_lut, x0, y1, c01);
-    fetchLanes(level, q.srgb_lut, x1, y1, c11);
+    alignas(32) float c00[J][4][kLanes], c10[J][4][kLanes], c01[J][4][kLanes], c11[J][4][kLanes];
+    for (int j = 0; j < J; ++j) {
+        fetchLanes(*levels[j], q.srgb_lut, x0[j], y0[j], c00[j]);
+        fetchLanes(*levels[j], q.srgb_lut, x1[j], y0[j], c10[j]);
+        fetchLanes(*levels[j], q.srgb_lut, x0[j], y1[j], c01[j]);
+        fetchLanes(*levels[j], q.srgb_lut, x1[j], y1[j], c11[j]);
+    }
     // glm::mix(a, b, t) = a * (1 - t) + b * t: across, then down.
-    for (int c = 0; c < 4; ++c)
-        for (int l = 0; l < kLanes; ++l) {
-            const float top = c00[c][l] * (1.0f - ax[l]) + c10[c][l] * ax[l];
-            const float bottom = c01[c][l] * (1.0f - ax[l]) + c11[c][l] * ax[l];
-            rgba[c][l] = top * (1.0f - ay[l]) + bottom * ay[l];
-        }
+    for (int j = 0; j < J; ++j)
+        for (int c = 0; c < 4; ++c)
+            for (int l = 0; l < kLanes; ++l) {
+                const float top = c00[j][c][l] * (1.0f - ax[j][l]) + c10[j][c][l] * ax[j][l];
+                const float bottom = c01[j][c][l] * (1.0f - ax[j][l]) + c11[j][c][l] * ax[j][l];
+                rgba[j][c][l] = top * (1.0f - ay[j][l]) + bottom * ay[j][l];
+            }
 }
 
 } // namespace
 
 void FOCAL_TEXTURE_KERNEL_NAME(const TextureQuery& query, TextureLanes& io) {
-    sampleLevelLanes(query, query.level[0], io.u, io.v, io.rgba);
-    if (!query.mix_levels)
+    if (!query.mix_levels) {
+        sampleLevelLanes<1>(query, {&query.level[0]}, io.u, io.v, {io.rgba});
         return;
+    }
     alignas(32) float upper[4][kLanes];
-    sampleLevelLanes(query, query.level[1], io.u, io.v, upper);
+    sampleLevelLanes<2>(query, {&query.level[0], &query.level[1]}, io.u, io.v, {io.rgba, upper});
     for (int c = 0; c < 4; ++c)
         for (int l = 0; l < kLanes; ++l)
             io.rgba[c][l] = io.rgba[c][l] * (1.0f - io.weight[l]) + upper[c][l] * io.weight[l];
