@@ -35,10 +35,16 @@ struct FrameSink {
         const float stored = frame.depth.quantize(z);
         return stored < frame.depth.load(pixel) && (!peel || stored > peel->load(pixel));
     }
-    // The two halves of write for a non-BLEND fragment, stored apart (the tile raster's light
-    // batch, and RenderOptions::depth_only's unshaded OPAQUE fragments, which store only depth).
+    // RenderOptions::depth_only: an unshaded OPAQUE fragment stores only its depth.
     void writeDepth(size_t pixel, float z) { frame.depth.store(pixel, z); }
-    void writeColor(size_t pixel, glm::vec4 c) {
+    // The two halves of write for a lit, non-BLEND fragment, stored apart by the tile raster's
+    // light queue: queue() stores what the next fragments' tests read (here the depth) and
+    // says where the colour goes, writeQueued() stores the colour once it is shaded.
+    size_t queue(size_t pixel, float z, uint32_t) {
+        frame.depth.store(pixel, z);
+        return pixel;
+    }
+    void writeQueued(size_t pixel, glm::vec4 c) {
         float* dst = &frame.color[pixel * 4];
         dst[0] = c.r, dst[1] = c.g, dst[2] = c.b, dst[3] = c.a;
     }
@@ -183,15 +189,24 @@ struct ListSink {
             }
         return true;
     }
-    void write(size_t pixel, const Fragment& f) {
-        pool.push_back({f.color, f.z, f.primitive_id, head[pixel]});
+    void write(size_t pixel, const Fragment& f) { writeNode(pixel, f.color, f.z, f.primitive_id); }
+    // The light queue's halves of write (FrameSink): the node and its key at once, in
+    // primitive order, its colour when shaded (node order is what decides; colours are read
+    // only by the resolve, after the tile).
+    size_t queue(size_t pixel, float z, uint32_t primitive_id) {
+        writeNode(pixel, glm::vec4(0.0f), z, primitive_id);
+        return pool.size() - 1;
+    }
+    void writeQueued(size_t node, glm::vec4 c) { pool[node].color = c; }
+    void writeNode(size_t pixel, glm::vec4 color, float z, uint32_t primitive_id) {
+        pool.push_back({color, z, primitive_id, head[pixel]});
         head[pixel] = uint32_t(pool.size() - 1);
         // Early rejection: the key joins the pixel's ascending keys (of k + 1, the largest goes).
         if (nearest) {
             const size_t t = tilePixel(pixel);
             float* d = nearest + t * k;
             const uint32_t n = used[t];
-            const float key = keyOf(f.z);
+            const float key = keyOf(z);
             // An unused slot counts as +inf: a +inf or NaN key is never stored.
             if (key < (n < k ? INFINITY : d[k - 1])) {
                 uint32_t i = n < k ? n : k - 1; // shift only the keys in use

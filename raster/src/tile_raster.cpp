@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <concepts>
 
 namespace raster {
 
@@ -79,15 +80,17 @@ glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
 // kQueuedLanes lit lanes is packed lane by lane (triangles that leave one or two lanes per pair,
 // dense: 1.9 on average), a pair with more is written by the fragment kernel straight into the
 // next whole block, its lanes in place. The kernel's lanes are independent, so neither changes
-// a bit. A queued lane's depth is stored when it is queued (the next triangle's depth test must
-// see it), its colour when the batch is shaded, in queue order, so a pixel queued twice still
-// ends with its later triangle's colour. The batch is shaded when full, when the lighting
-// constants change, before any colour written without it (unlit or BLEND lanes, which may land
-// on a queued pixel) and at the end of the tile. Only for sinks that store depth and colour
-// apart (the frame).
+// a bit. A queued lane goes to the sink when it is queued (`queue`: the frame's depth, which
+// the next triangle's depth test must see; a fragment list's node and key, in primitive order),
+// its colour when the batch is shaded (`writeQueued`), in queue order, so a pixel queued twice
+// still ends with its later triangle's colour. The batch is shaded when full, when the
+// lighting constants change, before any colour written without it (unlit or BLEND lanes, which
+// may land on a queued pixel) and at the end of the tile. For the sinks that can store a
+// fragment in these two halves: the frame and the fragment lists (not the layers, whose copies
+// into overlapping layers need the colour).
 template <class Sink> constexpr bool kBatchesLight = requires(Sink& s) {
-    s.writeDepth(size_t{}, 0.0f);
-    s.writeColor(size_t{}, glm::vec4{});
+    { s.queue(size_t{}, 0.0f, uint32_t{}) } -> std::same_as<size_t>;
+    s.writeQueued(size_t{}, glm::vec4{});
 };
 
 // Pairs with at most this many lit lanes are packed into the queue lane by lane.
@@ -97,7 +100,7 @@ struct LightBatch {
     static constexpr int kBlocks = 2;
     static constexpr int kLanes = kBlocks * kLightLanes;
     LightLanes block[kBlocks]{}; // zeroed once: the SIMD kernel reads every lane
-    size_t pixel[kLanes] = {};
+    size_t handle[kLanes] = {};  // where each lane's colour goes (the sink's queue())
     float alpha[kLanes] = {};
     uint32_t queued = 0; // bit i: lane i (block i / 8, lane i % 8) holds a queued fragment
     LightMaterial material;
@@ -116,7 +119,7 @@ template <class Sink> void shadeBatch(const RasterContext& ctx, LightBatch& batc
     for (uint32_t rest = batch.queued; rest != 0; rest &= rest - 1) {
         const int i = std::countr_zero(rest), l = i % kLightLanes;
         const LightLanes& b = batch.blockOf(i);
-        sink.writeColor(batch.pixel[i], {b.rgb[0][l], b.rgb[1][l], b.rgb[2][l], batch.alpha[i]});
+        sink.writeQueued(batch.handle[i], {b.rgb[0][l], b.rgb[1][l], b.rgb[2][l], batch.alpha[i]});
     }
     batch.count = 0;
     batch.queued = 0;
@@ -232,9 +235,8 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
             counters.passed += laneCount(passed);
             for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
                 const int l = std::countr_zero(rest);
-                const size_t pixel = first_pixel + tr.lane_offset[l];
-                sink.writeDepth(pixel, q.z[l]);
-                batch.pixel[start + l] = pixel;
+                batch.handle[start + l] =
+                    sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
             }
             batch.queued |= passed << start;
             batch.count = start + kLightLanes;
@@ -257,9 +259,9 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
             useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
             for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
                 const int l = std::countr_zero(rest);
-                const size_t pixel = first_pixel + tr.lane_offset[l];
-                sink.writeDepth(pixel, q.z[l]);
                 const int i = batch.count++, j = i % kLightLanes;
+                batch.handle[i] =
+                    sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
                 LightLanes& b = batch.blockOf(i);
                 for (int c = 0; c < 3; ++c) {
                     b.albedo[c][j] = light.albedo[c][l];
@@ -267,7 +269,6 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
                     b.world[c][j] = light.world[c][l];
                     b.normal[c][j] = light.normal[c][l];
                 }
-                batch.pixel[i] = pixel;
                 batch.alpha[i] = alpha[l];
                 batch.queued |= 1u << i;
                 if (batch.count == LightBatch::kLanes)
