@@ -29,6 +29,7 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -266,11 +267,9 @@ void BM_LightKernel(benchmark::State& state) {
     }
     std::vector<raster::PreparedLight> lights;
     raster::prepareLights(scene, glm::vec3(0.0f, -1.0f, 0.0f), lights);
-    uint32_t seed = 1u;
-    auto unit = [&seed] {
-        seed = seed * 1664525u + 1013904223u;
-        return float(seed >> 8) / 16777216.0f;
-    };
+    std::minstd_rand rng(1);
+    std::uniform_real_distribution<float> unit_dist(0.0f, 1.0f);
+    auto unit = [&] { return unit_dist(rng); };
     constexpr int kSets = 64;
     std::vector<raster::LightLanes> io(kSets * 2);
     for (raster::LightLanes& b : io)
