@@ -62,6 +62,15 @@ glm::vec4 fetch(const MipLevel& level, bool srgb, int x, int y) {
     return fetch(level, srgb ? srgbTable().data() : nullptr, x, y);
 }
 
+// fetch's value, read from the level's decoded texels where it keeps them (buildMipChain filled
+// them with fetch: the same values, from the array the texture kernel reads too).
+inline glm::vec4 texel(const MipLevel& level, const float* lut, int x, int y) {
+    if (level.linear.empty())
+        return fetch(level, lut, x, y);
+    const float* t = &level.linear[(size_t(y) * level.width + size_t(x)) * 4];
+    return {t[0], t[1], t[2], t[3]};
+}
+
 int wrapIndex(int64_t i, int n, Wrap wrap) {
     if (i >= 0 && i < n) // inside: every mode agrees, and it is by far the common case
         return int(i);
@@ -92,7 +101,7 @@ glm::vec4 sampleLevel(const Image& image, const MipLevel& level, const Sampler& 
     const double y = texelCoord(uv.y, level.height);
     if (filter == Filter::Nearest) {
         const int64_t ix = int64_t(std::floor(x + 0.5)), iy = int64_t(std::floor(y + 0.5));
-        return fetch(level, lut, wrapIndex(ix, w, s.wrap_s), wrapIndex(iy, h, s.wrap_t));
+        return texel(level, lut, wrapIndex(ix, w, s.wrap_s), wrapIndex(iy, h, s.wrap_t));
     }
     const double fx = std::floor(x), fy = std::floor(y);
     const float ax = float(x - fx), ay = float(y - fy);
@@ -100,8 +109,8 @@ glm::vec4 sampleLevel(const Image& image, const MipLevel& level, const Sampler& 
               x1 = wrapIndex(int64_t(fx) + 1, w, s.wrap_s);
     const int y0 = wrapIndex(int64_t(fy), h, s.wrap_t),
               y1 = wrapIndex(int64_t(fy) + 1, h, s.wrap_t);
-    const glm::vec4 top = glm::mix(fetch(level, lut, x0, y0), fetch(level, lut, x1, y0), ax);
-    const glm::vec4 bottom = glm::mix(fetch(level, lut, x0, y1), fetch(level, lut, x1, y1), ax);
+    const glm::vec4 top = glm::mix(texel(level, lut, x0, y0), texel(level, lut, x1, y0), ax);
+    const glm::vec4 bottom = glm::mix(texel(level, lut, x0, y1), texel(level, lut, x1, y1), ax);
     return glm::mix(top, bottom, ay);
 }
 

@@ -33,7 +33,8 @@ struct MipLevel {
     // The same texels decoded as a lookup decodes them (linear RGBA floats, sRGB colour through
     // the decoding table), for levels of at most kLinearLevelMaxTexels texels (buildMipChain);
     // empty otherwise. The texture kernel loads a texel's four channels from here in one
-    // access instead of gathering its word and then three table entries.
+    // access instead of gathering its word and then three table entries, and the one-fragment
+    // lookup (sampleImage) reads them too.
     std::vector<float> linear;
 };
 
