@@ -22,9 +22,14 @@ inline int32_t asInt(float f) {
     return __builtin_bit_cast(int32_t, f);
 }
 
-// The powers of J lights at once, each the same operations in the same order as for one: the
-// J dependency chains (about 40 steps of log2, exp2 and their divisions) are written step by
-// step side by side, so the core works on J of them at a time instead of waiting on one.
+// J powers at once (J independent inputs: lights, or lights x blocks), each the same operations
+// in the same order as for one: the J dependency chains (about 40 steps of log2, exp2 and their
+// divisions) are written step by step side by side, so the core works on J of them at a time
+// instead of waiting on one. The coefficients are plain arrays: no library template (such as
+// std::initializer_list) in this file (see quad_kernel.inl).
+constexpr float kLog2Series[] = {1.0f / 7.0f, 1.0f / 5.0f, 1.0f / 3.0f};
+constexpr float kExp2Series[] = {1.0f / 40320.0f, 1.0f / 5040.0f, 1.0f / 720.0f, 1.0f / 120.0f,
+                                 1.0f / 24.0f,    1.0f / 6.0f,    1.0f / 2.0f,   1.0f};
 
 // log2(x) for normal x > 0: x = m 2^e with m in [sqrt(1/2), sqrt(2)), then
 // log2(m) = 2/ln2 * atanh(t), t = (m-1)/(m+1), |t| < 0.172: five odd terms give ~1e-8.
@@ -44,7 +49,7 @@ template <int J> inline void log2Positive(const float (&x)[J], float (&out)[J]) 
         t2[j] = t[j] * t[j];
     for (int j = 0; j < J; ++j)
         q[j] = t2[j] / 9.0f;
-    for (const float c : {1.0f / 7.0f, 1.0f / 5.0f, 1.0f / 3.0f}) {
+    for (const float c : kLog2Series) {
         for (int j = 0; j < J; ++j)
             q[j] = c + q[j];
         for (int j = 0; j < J; ++j)
@@ -68,8 +73,7 @@ template <int J> inline void exp2NonPositive(const float (&y)[J], float (&out)[J
     // 1 + f (1 + f (1/2 + f (1/6 + ... + f (1/40320 + f/362880)))), innermost first.
     for (int j = 0; j < J; ++j)
         p[j] = f[j] * (1.0f / 362880.0f);
-    for (const float c : {1.0f / 40320.0f, 1.0f / 5040.0f, 1.0f / 720.0f, 1.0f / 120.0f,
-                          1.0f / 24.0f, 1.0f / 6.0f, 1.0f / 2.0f, 1.0f}) {
+    for (const float c : kExp2Series) {
         for (int j = 0; j < J; ++j)
             p[j] = c + p[j];
         for (int j = 0; j < J; ++j)

@@ -41,7 +41,7 @@ struct FrameSink {
     // light queue: queue() stores what the next fragments' tests read (here the depth) and
     // says where the colour goes, writeQueued() stores the colour once it is shaded.
     size_t queue(size_t pixel, float z, uint32_t) {
-        frame.depth.store(pixel, z);
+        writeDepth(pixel, z);
         return pixel;
     }
     void writeQueued(size_t pixel, glm::vec4 c) {
