@@ -687,22 +687,28 @@ TEST(Multiview, BaselineAndAvx2TracersGiveTheSameBytes) {
     // The tracer is compiled for the baseline x86-64 and for AVX2 (ShadingInputs::simd picks
     // the copy); the baseline is the reference, and the two must agree bit for bit: paths
     // walked in advance (in and off the image), per-pixel walks (noise jitter), the false
-    // position, transparent planes, per-ray shading and pixels resolved in focus.
+    // position, transparent planes, per-ray shading, pixels resolved in focus, missed cones
+    // off and a sample count that is not a multiple of 8. The counts `--stats` reports must
+    // agree too: they are part of what a run writes.
     struct Case {
         const char* scene;
         const char* config;
     };
-    for (const Case c : {Case{"demo", "default"}, Case{"demo", "noise"},
-                         Case{"nearsurface", "default"}, Case{"glass", "false position"},
-                         Case{"reflective", "view dependent"}, Case{"foliage", "discard"}}) {
+    for (const Case c : {Case{"demo", "default"}, Case{"demo", "noise"}, Case{"demo", "12 samples"},
+                         Case{"demo", "no missed cones"}, Case{"nearsurface", "default"},
+                         Case{"glass", "false position"}, Case{"reflective", "view dependent"},
+                         Case{"foliage", "discard"}}) {
         raster::Result<raster::Scene> scene = scenes::makeBuiltinScene(c.scene);
         ASSERT_TRUE(scene.ok());
         const raster::View view = raster::viewFromCamera(scene->cameras[0], 120, 90);
         const dof::ThinLens lens =
             dof::makeThinLens(view, scene->lens->aperture_radius, scene->lens->focus_distance);
-        const dof::LensSampleSet samples = makeSamples(16);
+        const dof::LensSampleSet samples =
+            makeSamples(std::strcmp(c.config, "12 samples") == 0 ? 12 : 16);
         dof::MultiviewSettings s;
         s.skip_unblurred = false;
+        if (std::strcmp(c.config, "no missed cones") == 0)
+            s.cone_misses = false;
         if (std::strcmp(c.config, "noise") == 0)
             s.jitter = dof::JitterMode::Noise;
         if (std::strcmp(c.config, "false position") == 0)
@@ -716,6 +722,14 @@ TEST(Multiview, BaselineAndAvx2TracersGiveTheSameBytes) {
         EXPECT_EQ(hashFloats(simd.frame.color), hashFloats(scalar.frame.color))
             << c.scene << " " << c.config;
         EXPECT_GT(simd.stats.rays, 0u) << c.scene << " " << c.config;
+        EXPECT_GT(simd.stats.layer_steps, 0u) << c.scene << " " << c.config;
+        EXPECT_EQ(simd.stats.layer_steps, scalar.stats.layer_steps) << c.scene << " " << c.config;
+        EXPECT_EQ(simd.stats.layer_tests, scalar.stats.layer_tests) << c.scene << " " << c.config;
+        EXPECT_EQ(simd.stats.texel_fetches, scalar.stats.texel_fetches)
+            << c.scene << " " << c.config;
+        EXPECT_EQ(simd.stats.cone_partial, scalar.stats.cone_partial)
+            << c.scene << " " << c.config;
+        EXPECT_EQ(simd.stats.cone_missed, scalar.stats.cone_missed) << c.scene << " " << c.config;
     }
 }
 
