@@ -727,8 +727,7 @@ TEST(Multiview, BaselineAndAvx2TracersGiveTheSameBytes) {
         EXPECT_EQ(simd.stats.layer_tests, scalar.stats.layer_tests) << c.scene << " " << c.config;
         EXPECT_EQ(simd.stats.texel_fetches, scalar.stats.texel_fetches)
             << c.scene << " " << c.config;
-        EXPECT_EQ(simd.stats.cone_partial, scalar.stats.cone_partial)
-            << c.scene << " " << c.config;
+        EXPECT_EQ(simd.stats.cone_partial, scalar.stats.cone_partial) << c.scene << " " << c.config;
         EXPECT_EQ(simd.stats.cone_missed, scalar.stats.cone_missed) << c.scene << " " << c.config;
     }
 }
