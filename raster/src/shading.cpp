@@ -18,11 +18,6 @@ const Sampler& samplerOf(const Scene& scene, const TextureRef& ref) {
     return ref.sampler >= 0 ? scene.samplers[size_t(ref.sampler)] : kDefaultSampler;
 }
 
-// KHR_texture_transform: uv' = M (u, v, 1).
-glm::vec2 transformUv(const TextureRef& ref, glm::vec2 uv) {
-    return glm::vec2(ref.transform * glm::vec3(uv, 1.0f));
-}
-
 // glTF/OpenGL LOD: log2 of the longer footprint axis in texels (OpenGL 4.6 §8.14.1). The
 // derivatives transform by the linear part of the texture transform.
 float levelOfDetail(const TextureRef& ref, const Image& image, glm::vec2 duv_dx, glm::vec2 duv_dy) {
@@ -56,12 +51,19 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
                     uint32_t lane_mask, float rgba[4][kTextureLanes]) {
     const Image& image = ctx.scene->images[size_t(ref.image)];
     const Sampler& sampler = samplerOf(*ctx.scene, ref);
-    const float lod[2] = {levelOfDetail(ref, image, in.duv_dx[0], in.duv_dy[0]),
-                          levelOfDetail(ref, image, in.duv_dx[1], in.duv_dy[1])};
+    float lod[2];
+    for (int q = 0; q < 2; ++q) {
+        const int l0 = 4 * q;
+        lod[q] = levelOfDetail(ref, image, {in.u[l0 + 1] - in.u[l0], in.v[l0 + 1] - in.v[l0]},
+                               {in.u[l0 + 2] - in.u[l0], in.v[l0 + 2] - in.v[l0]});
+    }
+    // KHR_texture_transform: uv' = M (u, v, 1), as glm's mat3 * vec3 computes it (the third
+    // term is M[2] * 1, which is M[2]), a lane loop the compiler vectorizes.
+    const glm::mat3& m = ref.transform;
     TextureLanes lanes;
     for (int l = 0; l < kTextureLanes; ++l) {
-        const glm::vec2 uv = transformUv(ref, in.uv[l]);
-        lanes.u[l] = uv.x, lanes.v[l] = uv.y;
+        lanes.u[l] = m[0][0] * in.u[l] + m[1][0] * in.v[l] + m[2][0];
+        lanes.v[l] = m[0][1] * in.u[l] + m[1][1] * in.v[l] + m[2][1];
     }
     // One by one when at most kFewLanes lanes are asked for (with gathers, an AVX2 kernel call
     // costs about as much as 1.3 one-fragment lookups; callgrind on ToyCar, docs/raster.md 8.2)

@@ -30,10 +30,12 @@ struct ShadeContext {
 };
 
 // Texture coordinates of the 8 lanes of two 2x2 quads (quad_kernel.h's lane order: lanes
-// 4q..4q+3 are quad q) and each quad's screen derivatives.
+// 4q..4q+3 are quad q, in the order (0, 0), (1, 0), (0, 1), (1, 1)), helper pixels included,
+// one array per component so the lane loops over them vectorize. Each quad's screen
+// derivatives are its lane 1 and lane 2 minus its lane 0 (coarse ddx, ddy).
 struct QuadPairUv {
-    glm::vec2 uv[kTextureLanes];
-    glm::vec2 duv_dx[2], duv_dy[2];
+    alignas(32) float u[kTextureLanes];
+    alignas(32) float v[kTextureLanes];
 };
 
 // `ref`'s texture (texture transform, level of detail, sampler) at the lanes of a quad pair set

@@ -70,10 +70,6 @@ void fillFragmentTriangle(const ShadeContext& shade, TriangleRaster& tr) {
     tr.frag_ready = true;
 }
 
-glm::vec2 interpolateUv(const TriangleRaster& tr, const QuadOutput& q, int l) {
-    return q.persp[0][l] * tr.v[0]->uv + q.persp[1][l] * tr.v[1]->uv + q.persp[2][l] * tr.v[2]->uv;
-}
-
 // Lit, non-BLEND lanes of a tile's quad pairs waiting for the lighting kernel, which shades two
 // blocks of eight lanes in one call for about 1.4 times the cost of one block (its chains
 // interleave, light_kernel.h). The blocks fill in queue order: a pair with at most
@@ -189,13 +185,12 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     QuadPairUv pair_uv; // read only when textured, then written in full
     if (textured) {
         // Every lane is interpolated (helper pixels included) so each quad has coarse
-        // derivatives, one pair per quad (as GPUs' ddx/ddy).
-        for (int l = 0; l < kQuadLanes; ++l)
-            pair_uv.uv[l] = interpolateUv(tr, q, l);
-        for (int quad = 0; quad < 2; ++quad) {
-            const glm::vec2* uv = &pair_uv.uv[4 * quad];
-            pair_uv.duv_dx[quad] = uv[1] - uv[0];
-            pair_uv.duv_dy[quad] = uv[2] - uv[0];
+        // derivatives, one pair per quad (as GPUs' ddx/ddy): sum_k persp_k uv_k, perspective-
+        // correct, summed in vertex order.
+        const glm::vec2 uv0 = tr.v[0]->uv, uv1 = tr.v[1]->uv, uv2 = tr.v[2]->uv;
+        for (int l = 0; l < kQuadLanes; ++l) {
+            pair_uv.u[l] = q.persp[0][l] * uv0.x + q.persp[1][l] * uv1.x + q.persp[2][l] * uv2.x;
+            pair_uv.v[l] = q.persp[0][l] * uv0.y + q.persp[1][l] * uv1.y + q.persp[2][l] * uv2.y;
         }
     }
 
