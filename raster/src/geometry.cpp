@@ -1,5 +1,7 @@
 #include "geometry.h"
 
+#include "binning.h"
+
 #include <raster/check.h>
 
 #include <glm/geometric.hpp>
@@ -18,6 +20,9 @@ namespace raster {
 namespace {
 
 constexpr uint32_t kVerticesPerBlock = 4096;
+
+// setupTriangle tests the pixel centres of bounding boxes up to this many pixels.
+constexpr int64_t kCoverageTestPixels = 4;
 
 // Clip planes as signed distances (inside >= 0) in homogeneous space.
 enum Plane : uint32_t { kNear, kFar, kLeft, kRight, kBottom, kTop, kPlaneCount };
@@ -160,6 +165,27 @@ void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& dr
     if (t.min_x > t.max_x || t.min_y > t.max_y) {
         ++chunk.triangles_culled;
         return;
+    }
+    // A small triangle (most of a dense mesh's) often covers no pixel centre although its box
+    // holds some: the box's few centres are tested with the tile raster's exact edge functions
+    // and fill rule, and a triangle that covers none is culled here, so binning and the raster
+    // never see it (they would find no covered sample: the same image).
+    if (int64_t(t.max_x - t.min_x + 1) * (t.max_y - t.min_y + 1) <= kCoverageTestPixels) {
+        Edge edges[3];
+        makeEdges(t, edges);
+        bool covers = false;
+        for (int32_t py = t.min_y; py <= t.max_y && !covers; ++py)
+            for (int32_t px = t.min_x; px <= t.max_x && !covers; ++px) {
+                const int64_t cx = int64_t(px) * kSubpixelOne + half;
+                const int64_t cy = int64_t(py) * kSubpixelOne + half;
+                covers = edges[0].at(cx, cy) + edges[0].bias >= 0 &&
+                         edges[1].at(cx, cy) + edges[1].bias >= 0 &&
+                         edges[2].at(cx, cy) + edges[2].bias >= 0;
+            }
+        if (!covers) {
+            ++chunk.triangles_culled;
+            return;
+        }
     }
     t.area2 = area2;
     t.draw = uint32_t(&draw - ctx.state.draws.data());

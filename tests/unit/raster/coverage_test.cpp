@@ -139,6 +139,24 @@ TEST(Coverage, HugeTriangleBeyondTheGuardBandCoversEveryPixelOnce) {
             ASSERT_EQ(pixel(f, x, y).r, 0.5f) << x << "," << y;
 }
 
+TEST(Coverage, SmallTriangleCoveringNoPixelCentreIsCulledAtSetup) {
+    // Two one-pixel triangles whose bounding boxes both hold the centre (10.5, 10.5): A's
+    // hypotenuse (x + y = 20.8) passes before it, B's (x + y = 21.2) beyond it. Set-up tests the
+    // few centres of a small box with the raster's edge functions: A is culled there and never
+    // reaches binning, B covers the pixel once.
+    raster::Scene s = blendScene();
+    addMesh(s, {at(9.9f, 9.9f), at(10.9f, 9.9f), at(9.9f, 10.9f)}, {0, 2, 1}, 0);
+    addMesh(s, {at(10.1f, 10.1f), at(11.1f, 10.1f), at(10.1f, 11.1f)}, {0, 2, 1}, 0);
+    raster::FrameStats stats;
+    const raster::Frame f = render(s, pixelView(kSize, kSize, kDist), {}, 0, &stats);
+    EXPECT_EQ(stats.triangles_in, 2u);
+    EXPECT_EQ(stats.triangles_culled, 1u);
+    EXPECT_EQ(stats.triangles_setup, 1u);
+    for (uint32_t y = 0; y < 16; ++y)
+        for (uint32_t x = 0; x < 16; ++x)
+            EXPECT_EQ(pixel(f, x, y).r, x == 10 && y == 10 ? 0.5f : 0.0f) << x << "," << y;
+}
+
 TEST(Coverage, ZeroAreaAndSliverTriangles) {
     raster::Scene s = blendScene();
     // Degenerate (collinear) and a sliver thinner than the snapping grid: nothing is drawn, no
