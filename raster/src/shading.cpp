@@ -38,6 +38,43 @@ TextureLevel kernelLevel(const MipLevel& level) {
             int32_t(level.height), level.linear.empty() ? nullptr : level.linear.data()};
 }
 
+// Whether the lookups of the `mask` lanes on `sel`'s levels read only texels whose colour is
+// zero, and alpha too unless `colour_only`: each tap's weight is finite and non-negative, so each
+// such lookup returns exactly zero there. The taps of a lane at u on a level of width w lie in
+// [floor(u w - 1/2), floor(u w - 1/2) + 1] (sampleLevel's texelCoord, the same double
+// arithmetic; nearest picks one of the two). Only windows inside the level, of a few blocks, and
+// finite coordinates are looked at; anything else is sampled.
+bool zeroFootprint(const Image& image, const LevelSelection& sel, const TextureLanes& lanes,
+                   uint32_t mask, bool colour_only) {
+    if (mask == 0)
+        return true; // no lane asked for: any value will do
+    float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    for (int l = 0; l < kTextureLanes; ++l)
+        if (mask & (1u << l)) {
+            if (!std::isfinite(lanes.u[l]) || !std::isfinite(lanes.v[l]))
+                return false;
+            u0 = std::min(u0, lanes.u[l]), u1 = std::max(u1, lanes.u[l]);
+            v0 = std::min(v0, lanes.v[l]), v1 = std::max(v1, lanes.v[l]);
+        }
+    constexpr int64_t kMaxBlocks = 16;
+    const uint32_t levels[2] = {sel.level0, sel.level1};
+    for (int j = 0; j < (sel.mix_levels ? 2 : 1); ++j) {
+        const MipLevel& level = image.levels[levels[j]];
+        const double w = double(level.width), h = double(level.height);
+        const int64_t x0 = int64_t(std::floor(double(u0) * w - 0.5));
+        const int64_t x1 = int64_t(std::floor(double(u1) * w - 0.5)) + 1;
+        const int64_t y0 = int64_t(std::floor(double(v0) * h - 0.5));
+        const int64_t y1 = int64_t(std::floor(double(v1) * h - 0.5)) + 1;
+        if (x0 < 0 || y0 < 0 || x1 >= int64_t(level.width) || y1 >= int64_t(level.height))
+            return false;
+        const int64_t side = kTexelBlockSide;
+        if ((x1 / side - x0 / side + 1) * (y1 / side - y0 / side + 1) > kMaxBlocks ||
+            !zeroTexels(level, x0, x1, y0, y1, !colour_only))
+            return false;
+    }
+    return true;
+}
+
 } // namespace
 
 TextureRoles sampledTextureRoles(ShadingMode) {
@@ -48,7 +85,7 @@ TextureRoles sampledTextureRoles(ShadingMode) {
 }
 
 void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& in,
-                    uint32_t lane_mask, float rgba[4][kTextureLanes]) {
+                    uint32_t lane_mask, bool colour_only, float rgba[4][kTextureLanes]) {
     const Image& image = ctx.scene->images[size_t(ref.image)];
     const Sampler& sampler = samplerOf(*ctx.scene, ref);
     float lod[2];
@@ -69,12 +106,17 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
     // costs about as much as 1.3 one-fragment lookups; callgrind on ToyCar, docs/raster.md 8.2)
     // or the image is beyond the kernel's integers.
     constexpr int kFewLanes = 1;
+    // Where the image has blocks of zero texels, lookups that read only those are zero.
+    const bool zeros = colour_only ? image.zero_colour_blocks : image.zero_blocks;
     if (laneCount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
         for (int l = 0; l < kTextureLanes; ++l) {
+            const bool asked = lane_mask & (1u << l);
             const glm::vec4 c =
-                lane_mask & (1u << l)
-                    ? sampleImage(image, sampler, ctx.filter, {lanes.u[l], lanes.v[l]}, lod[l / 4])
-                    : glm::vec4(0.0f); // a lane not asked for is still written (shading.h)
+                !asked || (zeros && zeroFootprint(
+                                        image, selectLevels(image, sampler, ctx.filter, lod[l / 4]),
+                                        lanes, 1u << l, colour_only))
+                    ? glm::vec4(0.0f) // a lane not asked for is still written (shading.h)
+                    : sampleImage(image, sampler, ctx.filter, {lanes.u[l], lanes.v[l]}, lod[l / 4]);
             for (int k = 0; k < 4; ++k)
                 rgba[k][l] = c[k];
         }
@@ -89,6 +131,14 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
     const bool shared = sel[0].level0 == sel[1].level0 && sel[0].level1 == sel[1].level1 &&
                         sel[0].filter == sel[1].filter && sel[0].mix_levels == sel[1].mix_levels;
     for (int q = 0; q < (shared ? 1 : 2); ++q) {
+        const int first = shared ? 0 : 4 * q, last = shared ? kTextureLanes : 4 * q + 4;
+        const uint32_t mask = shared ? lane_mask : lane_mask & (0xfu << first);
+        if (zeros && zeroFootprint(image, sel[q], lanes, mask, colour_only)) {
+            for (int k = 0; k < 4; ++k)
+                for (int l = first; l < last; ++l)
+                    rgba[k][l] = 0.0f;
+            continue;
+        }
         TextureQuery query;
         query.level[0] = kernelLevel(image.levels[sel[q].level0]);
         query.level[1] = kernelLevel(image.levels[sel[q].level1]);
@@ -98,7 +148,6 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
         query.nearest = sel[q].filter == Filter::Nearest;
         query.mix_levels = sel[q].mix_levels;
         ctx.texture_kernel(query, lanes);
-        const int first = shared ? 0 : 4 * q, last = shared ? kTextureLanes : 4 * q + 4;
         for (int k = 0; k < 4; ++k)
             for (int l = first; l < last; ++l)
                 rgba[k][l] = lanes.rgba[k][l];

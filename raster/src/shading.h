@@ -43,9 +43,11 @@ struct QuadPairUv {
 // `rgba` is written (those not asked for with unspecified values: the fragment kernel reads
 // them). One level of detail per quad, as GPUs compute it from the quad's derivatives. The
 // lanes are filtered together by the texture kernel, or one by one when only a few are asked
-// for (the kernel's cost does not depend on how many lanes are used).
+// for (the kernel's cost does not depend on how many lanes are used). `colour_only`: the caller
+// reads only the colour channels (emissive), so lookups that read only texels of zero colour are
+// skipped whatever their alpha; otherwise only those whose texels are all zero.
 void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
-                    uint32_t lanes, float rgba[4][kTextureLanes]);
+                    uint32_t lanes, bool colour_only, float rgba[4][kTextureLanes]);
 
 // Whether fragments of `m` skip lighting (KHR_materials_unlit or --shading unlit).
 bool isUnlit(const ShadeContext& ctx, const Material& m);

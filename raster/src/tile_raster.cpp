@@ -202,9 +202,9 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     // is given, fragment_kernel.h); the arrays are read only when sampled.
     alignas(32) float base_texel[4][kTextureLanes], emissive_texel[4][kTextureLanes];
     if (base_textured)
-        sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, tested, base_texel);
-    if (emissive_textured)
-        sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, tested, emissive_texel);
+        sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, tested, false, base_texel);
+    if (emissive_textured) // the fragment kernel reads the emissive colour, not its alpha
+        sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, tested, true, emissive_texel);
 
     // Every lane's attributes, base colour and alpha test (the fragment kernel), then the
     // lanes that pass are shaded together (the lighting kernel) and handed to the sink.

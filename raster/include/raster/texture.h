@@ -36,7 +36,18 @@ struct MipLevel {
     // access instead of gathering its word and then three table entries, and the one-fragment
     // lookup (sampleImage) reads them too.
     std::vector<float> linear;
+    // Per block of kTexelBlockSide x kTexelBlockSide texels (row-major, blocksX() per row):
+    // bit 0 set when some texel of the block has a non-zero colour channel, bit 1 when some
+    // has a non-zero alpha. Filled by buildMipChain; empty (nothing known) otherwise. Lets a
+    // lookup whose taps all read zero texels be skipped (zeroTexels): an emissive map is
+    // mostly black.
+    std::vector<uint8_t> nonzero;
+
+    uint32_t blocksX() const;
 };
+
+// The side of the texel blocks MipLevel::nonzero describes.
+constexpr uint32_t kTexelBlockSide = 8;
 
 // The largest mip level that also keeps its decoded texels (MipLevel::linear): 1024 x 1024,
 // 16 MB next to the level's 4 MB of bytes. A larger level 0 keeps only its bytes; its smaller
@@ -73,12 +84,21 @@ struct Image {
     // False when import skipped the image because none of its roles was asked for
     // (ImportOptions::roles): `levels` is then empty and nothing may sample it.
     bool decoded = true;
+    // Most of the levels' blocks have texels of zero colour (zero_colour_blocks), or zero colour
+    // and alpha (zero_blocks): MipLevel::nonzero is worth asking before a lookup
+    // (buildMipChain).
+    bool zero_colour_blocks = false, zero_blocks = false;
 };
 
 // Replaces image.levels[1..] with the full chain down to 1x1: each texel of level i+1 is the
 // average of the (up to) 2x2 texels of level i, computed in linear light and re-encoded. Then
-// fills MipLevel::linear of every level of at most kLinearLevelMaxTexels texels.
+// fills MipLevel::linear of every level of at most kLinearLevelMaxTexels texels, every level's
+// MipLevel::nonzero and the image's zero-block flags.
 void buildMipChain(Image& image);
+
+// Whether every texel of `level` in [x0, x1] x [y0, y1] (inside the level) has zero colour
+// channels, and zero alpha too with `alpha`, as MipLevel::nonzero tells (false when empty).
+bool zeroTexels(const MipLevel& level, int64_t x0, int64_t x1, int64_t y0, int64_t y1, bool alpha);
 
 // The filter the CLI may force on every sampler (--texture-filter).
 enum class FilterOverride : uint8_t { Sampler, Nearest, Bilinear, Trilinear };

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 
 namespace focal::test {
@@ -142,6 +143,103 @@ TEST(Texture, MinifiedCheckerAveragesToMidGreyWithTrilinear) {
             EXPECT_NEAR(pixel(tri, x, y).r, 0.5f, 0.01f) << x << "," << y;
             const float n = pixel(nearest, x, y).r;
             EXPECT_TRUE(n == 0.0f || n == 1.0f) << x << "," << y;
+        }
+}
+
+// An image of zero texels (every channel) with a few non-zero ones: colour only at (9, 2),
+// alpha only at (1, 5), in 8 x 8 blocks (0, 0) and (1, 0).
+TEST(Texture, MipChainMarksBlocksOfZeroTexels) {
+    Image img;
+    raster::MipLevel& level = img.levels.emplace_back();
+    level.width = 16;
+    level.height = 8;
+    level.rgba8.assign(16 * 8 * 4, 0);
+    level.rgba8[(2 * 16 + 9) * 4 + 1] = 5;
+    level.rgba8[(5 * 16 + 1) * 4 + 3] = 200;
+    raster::buildMipChain(img);
+    static_assert(raster::kTexelBlockSide == 8);
+    const raster::MipLevel& l0 = img.levels[0];
+    ASSERT_EQ(l0.nonzero.size(), 2u);
+    EXPECT_EQ(l0.nonzero[0], 2); // alpha only
+    EXPECT_EQ(l0.nonzero[1], 1); // colour only
+    EXPECT_TRUE(img.zero_colour_blocks);
+    EXPECT_TRUE(raster::zeroTexels(l0, 0, 7, 0, 7, false));
+    EXPECT_FALSE(raster::zeroTexels(l0, 0, 7, 0, 7, true));
+    EXPECT_FALSE(raster::zeroTexels(l0, 7, 8, 0, 0, false)); // reaches into block (1, 0)
+    const raster::MipLevel& top = img.levels.back(); // 1 x 1: zero unless the colour rounds up
+    EXPECT_EQ(raster::zeroTexels(top, 0, 0, 0, 0, false),
+              (top.rgba8[0] | top.rgba8[1] | top.rgba8[2]) == 0);
+    // A level not made by buildMipChain knows nothing: never zero.
+    raster::MipLevel bare = l0;
+    bare.nonzero.clear();
+    EXPECT_FALSE(raster::zeroTexels(bare, 0, 7, 0, 7, false));
+}
+
+// Lookups that read only zero texels are skipped (sampleQuadPair): the frame must be the one
+// sampled in full, texel for texel. A sparse image (most texels zero in every channel, a few
+// with colour, many with alpha only in one quarter) as base colour and emissive texture of opaque
+// and blended quads seen minified, near 1:1 and magnified, with coordinates beyond [0, 1] (repeat),
+// at every filter, with and without SIMD.
+TEST(Texture, LookupsOfZeroTexelsAreSkippedWithTheSameBits) {
+    Image img;
+    raster::MipLevel& level = img.levels.emplace_back();
+    level.width = level.height = 128;
+    level.rgba8.assign(128 * 128 * 4, 0);
+    // ~0.4 % of the texels have colour (with or without alpha); in the right quarter, 40 % more
+    // have alpha only (blocks of zero colour that are not zero).
+    uint32_t h = 12345;
+    for (size_t t = 0; t < 128 * 128; ++t) {
+        h = h * 1664525u + 1013904223u;
+        uint8_t* px = &level.rgba8[t * 4];
+        if ((h >> 22) < 4) {
+            px[0] = uint8_t(h >> 8), px[1] = uint8_t(h >> 16);
+            px[3] = (h >> 22) < 2 ? 255 : 0;
+        } else if (t % 128 >= 96 && (h >> 24) >= 150) {
+            px[3] = uint8_t(h >> 4) | 1;
+        }
+    }
+    raster::buildMipChain(img);
+    ASSERT_TRUE(img.zero_colour_blocks);
+    ASSERT_TRUE(img.zero_blocks);
+
+    raster::Scene s;
+    s.images.push_back(img);
+    raster::Material m = flatMaterial({1, 1, 1, 1});
+    m.base_color_texture.image = 0;
+    m.emissive_texture.image = 0;
+    m.emissive_factor = {0.5f, 1.0f, 2.0f};
+    const int32_t opaque = addMaterial(s, m);
+    m.alpha_mode = raster::AlphaMode::Blend; // the texels' alpha counts: only all-zero is skipped
+    const int32_t blend = addMaterial(s, m);
+    const float sizes[3] = {6.0f, 30.0f, 90.0f}; // half-widths in pixels at the pixel plane
+    const float x_at[3] = {-70.0f, -40.0f, 30.0f};
+    for (const int32_t mat : {opaque, blend})
+        for (int q = 0; q < 3; ++q) {
+            const float r = sizes[q], cx = x_at[q], cy = mat == opaque ? -50.0f : 50.0f;
+            raster::Primitive& p = addMesh(s,
+                                           {{cx - r, cy - r, -64},
+                                            {cx + r, cy - r, -64},
+                                            {cx + r, cy + r, -64},
+                                            {cx - r, cy + r, -64}},
+                                           {0, 1, 2, 0, 2, 3}, mat);
+            p.texcoords0 = {{-0.3f, 1.3f}, {1.3f, 1.2f}, {1.2f, -0.2f}, {-0.2f, -0.3f}};
+        }
+    raster::Scene unknown = s; // the same texels, no zero blocks known: everything is sampled
+    unknown.images[0].zero_colour_blocks = unknown.images[0].zero_blocks = false;
+    const raster::View v = pixelView(256, 256, 64.0f);
+    for (const FilterOverride f : {FilterOverride::Sampler, FilterOverride::Nearest,
+                                   FilterOverride::Bilinear, FilterOverride::Trilinear})
+        for (const bool simd : {true, false}) {
+            raster::RenderOptions o;
+            o.texture_filter = f;
+            o.simd = simd;
+            const raster::Frame skipped = render(s, v, o), sampled = render(unknown, v, o);
+            ASSERT_EQ(skipped.color.size(), sampled.color.size());
+            size_t differ = 0;
+            for (size_t i = 0; i < skipped.color.size(); ++i)
+                differ += std::bit_cast<uint32_t>(skipped.color[i]) !=
+                          std::bit_cast<uint32_t>(sampled.color[i]);
+            EXPECT_EQ(differ, 0u) << "filter " << int(f) << " simd " << simd;
         }
 }
 
