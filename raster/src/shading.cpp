@@ -19,13 +19,15 @@ const Sampler& samplerOf(const Scene& scene, const TextureRef& ref) {
 }
 
 // glTF/OpenGL LOD: log2 of the longer footprint axis in texels (OpenGL 4.6 §8.14.1). The
-// derivatives transform by the linear part of the texture transform.
+// derivatives transform by the linear part of the texture transform. A footprint of at most one
+// texel is magnification, where only the sign of the LOD counts (selectLevels): -1 without the
+// logarithm (log2 of rho2 <= 1 is <= 0, of NaN not > 0).
 float levelOfDetail(const TextureRef& ref, const Image& image, glm::vec2 duv_dx, glm::vec2 duv_dy) {
     const glm::mat2 lin(glm::vec2(ref.transform[0]), glm::vec2(ref.transform[1]));
     const glm::vec2 size(float(image.levels[0].width), float(image.levels[0].height));
     const glm::vec2 dx = lin * duv_dx * size, dy = lin * duv_dy * size;
     const float rho2 = std::max(glm::dot(dx, dx), glm::dot(dy, dy));
-    return rho2 > 0.0f ? 0.5f * std::log2(rho2) : -1.0f;
+    return rho2 > 1.0f ? 0.5f * std::log2(rho2) : -1.0f;
 }
 
 bool fitsTextureKernel(const MipLevel& level) {
