@@ -6,6 +6,7 @@
 #include "tile_raster.h"
 
 #include <raster/renderer.h>
+#include <raster/simd.h>
 #include <raster/surface_shading.h>
 
 #include <glm/geometric.hpp>
@@ -164,6 +165,7 @@ Status Renderer::prepare(const Scene& scene, const View& view, const RenderOptio
     st.ctx.shade.filter = options.texture_filter;
     st.ctx.kernel = selectQuadKernel(options.simd);
     st.ctx.fragment_kernel = selectFragmentKernel(options.simd);
+    st.ctx.avx2 = useAvx2(options.simd);
     st.ctx.blend_last = hasBlendMaterial(scene);
     st.ctx.depth_only = options.depth_only; // only FrameSink (render) has writeDepth
     prepareLights(scene, defaultLightDirection(view), st.lights);

@@ -352,10 +352,9 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     }
 }
 
-} // namespace
-
 template <class Sink>
-void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters) {
+void rasterizeTileImpl(const RasterContext& ctx, uint32_t tile, Sink& sink,
+                       TileCounters& counters) {
     const TileGrid& g = ctx.grid;
     const int32_t ts = int32_t(g.tile_size);
     const int32_t tx0 = int32_t(tile % g.tiles_x) * ts, ty0 = int32_t(tile / g.tiles_x) * ts;
@@ -406,6 +405,37 @@ void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCoun
     counters.covered += local.covered;
     counters.passed += local.passed;
     counters.rejected += local.rejected;
+}
+
+// rasterizeTileImpl compiled twice, for the baseline x86-64 and for AVX2 (multiview's traceTile
+// does the same): `flatten` inlines what it calls from this file into each copy. The kernels stay
+// behind their pointers; what the AVX2 copy changes is the code around them (lane loops 8 wide,
+// blends for selects). No FMA and no reassociation, so the same bits.
+template <class Sink>
+__attribute__((flatten)) void rasterizeTileBaseline(const RasterContext& ctx, uint32_t tile,
+                                                    Sink& sink, TileCounters& counters) {
+    rasterizeTileImpl(ctx, tile, sink, counters);
+}
+
+#if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
+template <class Sink>
+__attribute__((flatten, target("avx2,no-fma"))) void
+rasterizeTileAvx2(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters) {
+    rasterizeTileImpl(ctx, tile, sink, counters);
+}
+#endif
+
+} // namespace
+
+template <class Sink>
+void rasterizeTile(const RasterContext& ctx, uint32_t tile, Sink& sink, TileCounters& counters) {
+#if defined(__x86_64__) && !defined(FOCAL_NO_SIMD)
+    if (ctx.avx2) {
+        rasterizeTileAvx2(ctx, tile, sink, counters);
+        return;
+    }
+#endif
+    rasterizeTileBaseline(ctx, tile, sink, counters);
 }
 
 template void rasterizeTile<FrameSink>(const RasterContext&, uint32_t, FrameSink&, TileCounters&);

@@ -27,6 +27,7 @@ struct RasterContext {
     FragmentKernel fragment_kernel = &fragmentKernelScalar;
     bool blend_last = false; // the scene has BLEND materials: draw their triangles last
     bool depth_only = false; // RenderOptions::depth_only (a sink with writeDepth)
+    bool avx2 = false;       // rasterizeTile runs its AVX2 copy (useAvx2)
 };
 
 struct TileCounters {

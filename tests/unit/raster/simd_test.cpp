@@ -280,6 +280,8 @@ TEST(Simd, TextureKernelMatchesSampleImageBitForBit) {
     EXPECT_EQ(checked, 6 * 2 * 400);
 }
 
+// Whole renders: every kernel and the tile raster's AVX2 copy (rasterizeTile) against the
+// scalar reference path.
 TEST(Simd, RendersMatchTheScalarPathOnBuiltinScenes) {
     for (const char* name : {"demo", "foliage", "glass", "reflective"}) {
         raster::Result<raster::Scene> s = scenes::makeBuiltinScene(name);
