@@ -63,12 +63,12 @@ bool zeroFootprint(const Image& image, const LevelSelection& sel, const TextureL
     for (int j = 0; j < (sel.mix_levels ? 2 : 1); ++j) {
         const MipLevel& level = image.levels[levels[j]];
         const double w = double(level.width), h = double(level.height);
-        const int64_t x0 = int64_t(std::floor(double(u0) * w - 0.5));
-        const int64_t x1 = int64_t(std::floor(double(u1) * w - 0.5)) + 1;
-        const int64_t y0 = int64_t(std::floor(double(v0) * h - 0.5));
-        const int64_t y1 = int64_t(std::floor(double(v1) * h - 0.5)) + 1;
-        if (x0 < 0 || y0 < 0 || x1 >= int64_t(level.width) || y1 >= int64_t(level.height))
-            return false;
+        const double fx0 = std::floor(double(u0) * w - 0.5), fx1 = std::floor(double(u1) * w - 0.5);
+        const double fy0 = std::floor(double(v0) * h - 0.5), fy1 = std::floor(double(v1) * h - 0.5);
+        if (!(fx0 >= 0.0 && fy0 >= 0.0 && fx1 + 1.0 < w && fy1 + 1.0 < h))
+            return false; // off the level (also huge coordinates: tested before the casts)
+        const int64_t x0 = int64_t(fx0), x1 = int64_t(fx1) + 1;
+        const int64_t y0 = int64_t(fy0), y1 = int64_t(fy1) + 1;
         const int64_t side = kTexelBlockSide;
         if ((x1 / side - x0 / side + 1) * (y1 / side - y0 / side + 1) > kMaxBlocks ||
             !zeroTexels(level, x0, x1, y0, y1, !colour_only))

@@ -224,6 +224,12 @@ TEST(Texture, LookupsOfZeroTexelsAreSkippedWithTheSameBits) {
                                            {0, 1, 2, 0, 2, 3}, mat);
             p.texcoords0 = {{-0.3f, 1.3f}, {1.3f, 1.2f}, {1.2f, -0.2f}, {-0.2f, -0.3f}};
         }
+    // Coordinates far beyond any level (finite, but no integer type holds their texel index):
+    // sampled, not asked about the blocks.
+    raster::Primitive& huge =
+        addMesh(s, {{60, 60, -64}, {100, 60, -64}, {100, 100, -64}, {60, 100, -64}},
+                {0, 1, 2, 0, 2, 3}, opaque);
+    huge.texcoords0 = {{1e30f, 1e30f}, {-1e30f, 1e30f}, {1e30f, 2e30f}, {3e30f, -1e30f}};
     raster::Scene unknown = s; // the same texels, no zero blocks known: everything is sampled
     unknown.images[0].zero_colour_blocks = unknown.images[0].zero_blocks = false;
     const raster::View v = pixelView(256, 256, 64.0f);
