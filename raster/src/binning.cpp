@@ -30,27 +30,6 @@ void makeEdges(const SetupTri& t, Edge edges[3]) {
     }
 }
 
-namespace {
-
-// Pixel centre of pixel index i, in fixed point.
-int64_t centre(int64_t i) {
-    return i * kSubpixelOne + kSubpixelOne / 2;
-}
-
-// True when some pixel centre of the rectangle [x0,x1]x[y0,y1] may be inside all three edges.
-bool rectMayOverlap(const Edge edges[3], int64_t x0, int64_t y0, int64_t x1, int64_t y1) {
-    for (int k = 0; k < 3; ++k) {
-        const Edge& e = edges[k];
-        const int64_t px = e.a > 0 ? centre(x1) : centre(x0);
-        const int64_t py = e.b > 0 ? centre(y1) : centre(y0);
-        if (e.at(px, py) + e.bias < 0)
-            return false;
-    }
-    return true;
-}
-
-} // namespace
-
 void binChunks(TaskPool& pool, const GeometryState& geometry, const TileGrid& grid,
                std::vector<ChunkBins>& bins) {
     bins.resize(geometry.chunks.size());

@@ -37,6 +37,26 @@ struct Edge {
 // The three edges of t; edge k is opposite vertex k, so E_k / area2 is barycentric k.
 void makeEdges(const SetupTri& t, Edge edges[3]);
 
+// The centre of pixel index i, in fixed point: where coverage is sampled.
+inline int64_t pixelCentre(int64_t i) {
+    return i * kSubpixelOne + kSubpixelOne / 2;
+}
+
+// True when some pixel centre of the rectangle [x0, x1] x [y0, y1] may be inside all three
+// edges (each edge tested at the rectangle's most inside centre); for one pixel, exactly
+// whether its centre is covered. Binning's tile test, the tile raster's block reject and
+// set-up's small-triangle test.
+inline bool rectMayOverlap(const Edge edges[3], int64_t x0, int64_t y0, int64_t x1, int64_t y1) {
+    for (int k = 0; k < 3; ++k) {
+        const Edge& e = edges[k];
+        const int64_t px = e.a > 0 ? pixelCentre(x1) : pixelCentre(x0);
+        const int64_t py = e.b > 0 ? pixelCentre(y1) : pixelCentre(y0);
+        if (e.at(px, py) + e.bias < 0)
+            return false;
+    }
+    return true;
+}
+
 // Bins every chunk (in parallel; each chunk writes only its own ChunkBins).
 void binChunks(TaskPool& pool, const GeometryState& geometry, const TileGrid& grid,
                std::vector<ChunkBins>& bins);

@@ -175,13 +175,8 @@ void setupTriangle(const ChunkContext& ctx, GeometryChunk& chunk, const Draw& dr
         makeEdges(t, edges);
         bool covers = false;
         for (int32_t py = t.min_y; py <= t.max_y && !covers; ++py)
-            for (int32_t px = t.min_x; px <= t.max_x && !covers; ++px) {
-                const int64_t cx = int64_t(px) * kSubpixelOne + half;
-                const int64_t cy = int64_t(py) * kSubpixelOne + half;
-                covers = edges[0].at(cx, cy) + edges[0].bias >= 0 &&
-                         edges[1].at(cx, cy) + edges[1].bias >= 0 &&
-                         edges[2].at(cx, cy) + edges[2].bias >= 0;
-            }
+            for (int32_t px = t.min_x; px <= t.max_x && !covers; ++px)
+                covers = rectMayOverlap(edges, px, py, px, py);
         if (!covers) {
             ++chunk.triangles_culled;
             return;

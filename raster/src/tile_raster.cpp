@@ -18,10 +18,6 @@ static_assert(kQuadLanes == kTextureLanes, "the texture kernel samples a quad pa
 
 constexpr int32_t kBlockSize = 8; // hierarchical test: tile -> 8x8 block -> 2x2 quad -> pixel
 
-int64_t centre(int64_t i) {
-    return i * kSubpixelOne + kSubpixelOne / 2;
-}
-
 // Per-triangle constants for the pixel loop.
 struct TriangleRaster {
     const SetupTri* tri;
@@ -140,7 +136,7 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     const SetupTri& t = *tr.tri;
     QuadInput& in = tr.quad;
     for (int k = 0; k < 3; ++k)
-        in.edge[k] = double(tr.edges[k].at(centre(qx), centre(qy)));
+        in.edge[k] = double(tr.edges[k].at(pixelCentre(qx), pixelCentre(qy)));
     in.valid = 0xffu;
     if (qx + 3 >= int32_t(ctx.grid.width) || qy + 1 >= int32_t(ctx.grid.height)) {
         in.valid = 0; // on the right or bottom border of the viewport
@@ -336,14 +332,7 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
         for (int32_t bx = x0; bx <= x1; bx += kBlockSize - (bx % kBlockSize)) {
             const int32_t bx1 = std::min(bx + kBlockSize - 1 - (bx % kBlockSize), x1);
             // Block reject: some edge is negative at the block's most inside corner.
-            bool reject = false;
-            for (int k = 0; k < 3 && !reject; ++k) {
-                const Edge& e = tr.edges[k];
-                const int64_t px = e.a > 0 ? centre(bx1) : centre(bx);
-                const int64_t py = e.b > 0 ? centre(by1) : centre(by);
-                reject = e.at(px, py) + e.bias < 0;
-            }
-            if (reject)
+            if (!rectMayOverlap(tr.edges, bx, by, bx1, by1))
                 continue;
             for (int32_t qy = by; qy <= by1; qy += 2)
                 for (int32_t qx = bx; qx <= bx1; qx += 4)
