@@ -45,11 +45,9 @@ TextureLevel kernelLevel(const MipLevel& level) {
 // such lookup returns exactly zero there. The taps of a lane at u on a level of width w lie in
 // [floor(u w - 1/2), floor(u w - 1/2) + 1] (sampleLevel's texelCoord, the same double
 // arithmetic; nearest picks one of the two). Only windows inside the level, of a few blocks, and
-// finite coordinates are looked at; anything else is sampled.
+// finite coordinates are looked at; anything else is sampled. `mask` is not empty.
 bool zeroFootprint(const Image& image, const LevelSelection& sel, const TextureLanes& lanes,
                    uint32_t mask, bool colour_only) {
-    if (mask == 0)
-        return true; // no lane asked for: any value will do
     float u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
     for (int l = 0; l < kTextureLanes; ++l)
         if (mask & (1u << l)) {
@@ -112,13 +110,12 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
     const bool zeros = colour_only ? image.zero_colour_blocks : image.zero_blocks;
     if (laneCount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
         for (int l = 0; l < kTextureLanes; ++l) {
-            const bool asked = lane_mask & (1u << l);
-            const glm::vec4 c =
-                !asked || (zeros && zeroFootprint(
-                                        image, selectLevels(image, sampler, ctx.filter, lod[l / 4]),
-                                        lanes, 1u << l, colour_only))
-                    ? glm::vec4(0.0f) // a lane not asked for is still written (shading.h)
-                    : sampleImage(image, sampler, ctx.filter, {lanes.u[l], lanes.v[l]}, lod[l / 4]);
+            glm::vec4 c(0.0f); // a lane not asked for is still written (shading.h)
+            if (lane_mask & (1u << l)) {
+                const LevelSelection sel = selectLevels(image, sampler, ctx.filter, lod[l / 4]);
+                if (!zeros || !zeroFootprint(image, sel, lanes, 1u << l, colour_only))
+                    c = sampleLevels(image, sampler, sel, {lanes.u[l], lanes.v[l]});
+            }
             for (int k = 0; k < 4; ++k)
                 rgba[k][l] = c[k];
         }
@@ -135,7 +132,8 @@ void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPa
     for (int q = 0; q < (shared ? 1 : 2); ++q) {
         const int first = shared ? 0 : 4 * q, last = shared ? kTextureLanes : 4 * q + 4;
         const uint32_t mask = shared ? lane_mask : lane_mask & (0xfu << first);
-        if (zeros && zeroFootprint(image, sel[q], lanes, mask, colour_only)) {
+        // A quad with no lane asked for, or whose lookups read only zero texels, is not sampled.
+        if (mask == 0 || (zeros && zeroFootprint(image, sel[q], lanes, mask, colour_only))) {
             for (int k = 0; k < 4; ++k)
                 for (int l = first; l < last; ++l)
                     rgba[k][l] = 0.0f;

@@ -250,7 +250,11 @@ glm::vec4 sampleImage(const Image& image, const Sampler& sampler, FilterOverride
                       glm::vec2 uv, float lod) {
     if (image.levels.empty())
         return glm::vec4(1.0f);
-    const LevelSelection s = selectLevels(image, sampler, filter, lod);
+    return sampleLevels(image, sampler, selectLevels(image, sampler, filter, lod), uv);
+}
+
+glm::vec4 sampleLevels(const Image& image, const Sampler& sampler, const LevelSelection& s,
+                       glm::vec2 uv) {
     const glm::vec4 a = sampleLevel(image, image.levels[s.level0], sampler, s.filter, uv);
     if (!s.mix_levels)
         return a;

@@ -119,6 +119,10 @@ struct LevelSelection {
 LevelSelection selectLevels(const Image& image, const Sampler& sampler, FilterOverride filter,
                             float lod);
 
+// sampleImage's lookup once the levels are selected (image.levels must not be empty).
+glm::vec4 sampleLevels(const Image& image, const Sampler& sampler, const LevelSelection& s,
+                       glm::vec2 uv);
+
 // The 256-entry table decoding 8-bit sRGB to linear (srgbToLinear(i / 255)).
 const float* srgbDecodeTable();
 
