@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <ostream>
 #include <string>
@@ -122,13 +123,12 @@ void PrintTo(const DofCase& c, std::ostream* os) {
     *os << ")";
 }
 
-// A fresh folder for one test's renders, removed when the test passes.
+// A fresh folder for one test's renders, removed when the test passes. A parameterised test's
+// name holds a '/' ("MatchesReference/accum_demo"): kept, it would make the folder a subfolder
+// and leave its parent behind.
 class ScratchDir {
 public:
-    ScratchDir()
-        : path_(fs::temp_directory_path() /
-                ("focal-dof-golden-" + std::to_string(::getpid()) + "-" +
-                 ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
+    ScratchDir() : path_(fs::temp_directory_path() / folderName()) {
         fs::remove_all(path_);
         fs::create_directories(path_);
     }
@@ -143,6 +143,12 @@ public:
     const fs::path& path() const { return path_; }
 
 private:
+    static std::string folderName() {
+        std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        std::replace(test.begin(), test.end(), '/', '_');
+        return "focal-dof-golden-" + std::to_string(::getpid()) + "-" + test;
+    }
+
     fs::path path_;
 };
 
