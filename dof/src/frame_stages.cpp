@@ -484,6 +484,7 @@ void FrameRenderer::multiviewStages(const raster::View& view, const ThinLens& le
         b.ms(stageMs(report, "decomposition"));
         b.count("layers", double(st.layers));
         b.count("layers_empty", double(st.layers_empty));
+        b.count("guard_band_px", double(st.guard_band_px));
         b.count("delta_px", double(st.delta_px));
         b.count("d_near", double(st.d_near));
         b.count("d_far", double(st.d_far));
@@ -504,18 +505,20 @@ void FrameRenderer::multiviewStages(const raster::View& view, const ThinLens& le
                        "overlap, layers) its depth falls in, and every layer has its own depth "
                        "buffer, so a layer keeps the nearest surface of its depth interval even "
                        "where a nearer layer hides it. Colour is shown times coverage; depth is "
-                       "the stored distance of the layer's surface.");
+                       "the stored distance of the layer's surface. The layers cover the image "
+                       "and a guard band around it (§4.3), where rays leaving the image read.");
         b.count("layers", double(t.layer_count));
+        b.count("guard_band_px", double(st.guard_band_px));
         const size_t n = t.pixelCount();
         for (uint32_t l = 0; l < t.layer_count; ++l) {
             float* c = b.image(layerName(l) + " colour", "colour times coverage",
-                               StageImageKind::Color, w, h, 4);
+                               StageImageKind::Color, t.width, t.height, 4);
             for (size_t i = 0; i < n; ++i)
                 storePremultiplied(t.color.load(size_t(l) * n + i), c + 4 * i);
         }
         for (uint32_t l = 0; l < t.layer_count; ++l)
             distanceImage(b, layerName(l) + " depth", "distance of the layer's surface", pin,
-                          t.depth, size_t(l) * n, w, h);
+                          t.depth, size_t(l) * n, t.width, t.height);
         b.send(observer);
     }
     if (traced) {

@@ -112,9 +112,14 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     if (Status st = validate(lens, view); !st.ok())
         return st;
     const uint32_t width = view.width, height = view.height;
-    if (pinhole.width != width || pinhole.height != height || layers.width != width ||
-        layers.height != height)
-        return Status::error("multiview: the pinhole frame and layers must match the view size");
+    if (pinhole.width != width || pinhole.height != height)
+        return Status::error("multiview: the pinhole frame must match the view size");
+    // The layers cover the image and a guard band of the same width on every side (guardedView).
+    if (layers.width < width || layers.height < height ||
+        layers.width - width != layers.height - height || (layers.width - width) % 2 != 0)
+        return Status::error("multiview: the layers must match the view size, or exceed it by a "
+                             "guard band as wide on every side");
+    const uint32_t guard = (layers.width - width) / 2;
     if (layers.layer_count == 0 || layers.layer_count > raster::kMaxLayers)
         return Status::error("multiview: the layered target has no layers");
     const bool shade = settings.view_dependent || settings.env_map;
@@ -129,6 +134,7 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     const uint32_t m = layers.layer_count;
     stats.layers = m;
     stats.delta_px = spacing.delta_px;
+    stats.guard_band_px = guard;
     stats.budget_limited = spacing.budget_limited;
     stats.layered_bytes = layers.bytes();
 
@@ -139,8 +145,11 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
     Tracer& tr = fs.tracer;
     tr.reset();
     bindTracer(tr, view, lens, samples, pinhole, layers, settings, shading, scratch);
-    tr.width = width;
-    tr.height = height;
+    tr.width = layers.width;
+    tr.height = layers.height;
+    tr.guard = guard;
+    tr.image_width = width;
+    tr.image_height = height;
     tr.background = background;
     if (shade) {
         // Kept with the frame state: preparing it again reuses its memory.
@@ -220,7 +229,8 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         }
     }
 
-    // §4.3: trace every pixel's lens rays, one task per output tile.
+    // §4.3: trace every pixel's lens rays, one task per output tile (the guard band's pixels
+    // are read, not traced).
     t0 = Clock::now();
     if (settings.precompute_paths && settings.jitter == JitterMode::None &&
         settings.traversal == Traversal::Scan && walkPaths(tr, stats)) {
@@ -245,8 +255,9 @@ synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSa
         // Counted on the stack, stored once: neighbouring tiles' counters share cache lines,
         // and the two workers usually trace neighbouring tiles.
         TileCounters cnt;
-        const uint32_t x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
-        const uint32_t x1 = std::min(x0 + ts, width), y1 = std::min(y0 + ts, height);
+        const uint32_t x0 = guard + (tile % tiles_x) * ts, y0 = guard + (tile / tiles_x) * ts;
+        const uint32_t x1 = std::min(x0 + ts, guard + width);
+        const uint32_t y1 = std::min(y0 + ts, guard + height);
         std::array<uint32_t, raster::kMaxLayers> tile_layers{};
         const uint32_t count = tileLayers(tr, x0, x1, y0, y1, tile_layers.data(), cnt);
         trace_tile(tr, x0, x1, y0, y1, tile_layers.data(), count,
@@ -310,11 +321,14 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     // Nothing to blur: the pinhole render is the result (the same rule as accum's, so both
     // methods return the pinhole image for the same lenses). Rays offset by less than half a
     // pixel would read every pixel's own texel anyway.
+    const bool skip_test = settings.skip_unblurred && !settings.env_map;
+    CocRange coc;
+    if (range.covered && (skip_test || settings.guard_band_px > 0.0f))
+        coc = visibleCocRange(lens, pinhole, view);
     std::string skip_reason;
     if (!range.covered) {
         skip_reason = "nothing visible: the image is the background";
-    } else if (settings.skip_unblurred && !settings.env_map) {
-        const CocRange coc = visibleCocRange(lens, pinhole, view);
+    } else if (skip_test) {
         if (lens.aperture_radius == 0.0f) {
             skip_reason = "aperture radius is 0 (pinhole)";
         } else if (coc.max_abs_px < 0.5f) {
@@ -351,8 +365,10 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
         return st;
     raster::LayeredTarget local_layers;
     raster::LayeredTarget& layers = layers_out ? *layers_out : local_layers;
+    // §4.3's viewport that encompasses the lens rays: a ray from the lens rim moves |C(d)| px.
+    const uint32_t guard = uint32_t(std::min(settings.guard_band_px, std::ceil(coc.max_abs_px)));
     t0 = Clock::now();
-    if (Status st = render_layers(view, fs.desc, layers); !st.ok())
+    if (Status st = render_layers(guardedView(view, guard), fs.desc, layers); !st.ok())
         return st;
     const double ms_layers = msSince(t0);
     raster::Result<MultiviewStats> r =
@@ -367,6 +383,17 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     return r;
 } catch (const std::bad_alloc&) {
     return detail::outOfMemory("rendering multiview");
+}
+
+raster::View guardedView(const raster::View& view, uint32_t guard) {
+    raster::View v = view;
+    v.width = view.width + 2 * guard;
+    v.height = view.height + 2 * guard;
+    // f_px = (H/2) / tan(yfov/2) kept: tan(yfov'/2) = tan(yfov/2) H' / H (in double, so that
+    // f_px is kept to the float's last bits or so).
+    v.yfov = float(2.0 * std::atan(std::tan(0.5 * double(view.yfov)) * double(v.height) /
+                                   double(view.height)));
+    return v;
 }
 
 Status probeMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
@@ -391,9 +418,9 @@ Status probeMultiview(const raster::View& view, const ThinLens& lens, const Lens
         return {};
     }
     const Tracer& kept = fs->tracer;
-    if (view.width != kept.width || view.height != kept.height || layers.width != kept.width ||
-        layers.height != kept.height || layers.layer_count != kept.segs.size() ||
-        samples.size() != fs->sample_count)
+    if (view.width != kept.image_width || view.height != kept.image_height ||
+        layers.width != kept.width || layers.height != kept.height ||
+        layers.layer_count != kept.segs.size() || samples.size() != fs->sample_count)
         return Status::error("multiview probe: the view, layers or samples are not the frame's");
     if (Status st = validate(settings, samples.size()); !st.ok())
         return st;

@@ -143,6 +143,14 @@ const Param<S> kParams[] = {
       .paper = "Lee et al. 2009, §4.3",
       .help = "rays leaving the image: clamp (read the border texels) or discard (the paper)"},
      field<&S::offscreen>()},
+    {{.name = "guard_band_px",
+      .flag = "guard-band",
+      .max = 1024.0,
+      .paper = "Lee et al. 2009, §4.3 (Handling Off-Screen Pixels)",
+      .help = "render the layers over the image and a band around it as wide as the largest "
+              "visible |C|, at most this many pixels, so rays leaving the image read the scene "
+              "there (0: the image alone, the paper's choice)"},
+     field<&S::guard_band_px>()},
     {{.name = "view_dependent",
       .flag = "view-dependent",
       .type = ParamType::Flag,

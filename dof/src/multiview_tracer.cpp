@@ -49,7 +49,8 @@ float nextUp(float x) {
     return std::bit_cast<float>(x > 0.0f ? bits + 1 : bits - 1);
 }
 
-// The lens position of sample k at pixel (x, y) under the jitter mode (§4.5), and its weight.
+// The lens position of sample k at output pixel (x, y) under the jitter mode (§4.5), and its
+// weight.
 LensSample jitteredSample(const Tracer& tr, uint32_t x, uint32_t y, uint32_t k,
                           const std::array<float, 4>& noise, uint32_t halton_offset) {
     const MultiviewSettings& s = *tr.settings;
@@ -86,7 +87,7 @@ struct NoRecorder {
     static constexpr bool kOn = false;
     // Where pixel (x, y)'s result goes: the frame's image.
     static float* pixelOut(float* rgba, const Tracer& tr, uint32_t x, uint32_t y, bool) {
-        return rgba + (size_t(y) * tr.width + x) * 4;
+        return rgba + (size_t(y - tr.guard) * tr.image_width + (x - tr.guard)) * 4;
     }
 };
 
@@ -143,10 +144,12 @@ struct ProbeRecorder {
         if (!dropped)
             r.rgba[0] = color.r, r.rgba[1] = color.g, r.rgba[2] = color.b, r.rgba[3] = 1.0f;
     }
-    // The image position of pixel (x, y)'s ray at stored depth t (Eq. 2-3).
+    // The output image position of the ray of the layers' pixel (x, y) at stored depth t
+    // (Eq. 2-3).
     static glm::vec2 pointAt(const Tracer& tr, uint32_t x, uint32_t y, const RayState& ray,
                              float t) {
-        return glm::vec2(float(x) + 0.5f, float(y) + 0.5f) + tr.cocOf(t) * ray.w;
+        const float g = float(tr.guard);
+        return glm::vec2(float(x) - g + 0.5f, float(y) - g + 0.5f) + tr.cocOf(t) * ray.w;
     }
     void endStep(const RayState& ray, const TileCounters& cnt) {
         step->fetches = uint32_t(cnt.fetches - step_fetches);
@@ -213,14 +216,16 @@ template <class Rec>
 void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCounters& cnt,
                Rec& rec) {
     const MultiviewSettings& s = *tr.settings;
-    // Per-pixel jitter keys (§4.5): a pure function of (x, y, seed).
+    // Per-pixel jitter keys (§4.5): a pure function of the output pixel (ix, iy) and the seed,
+    // whatever the guard band.
+    const uint32_t ix = x - tr.guard, iy = y - tr.guard;
     std::array<float, 4> noise{};
     uint32_t halton_offset = 0;
     if (s.jitter == JitterMode::Noise)
         for (uint32_t c = 0; c < 4; ++c)
-            noise[c] = hashToUnit(hashWords(x, y, s.seed, 0x6e6f6973u + c)) - 0.5f;
+            noise[c] = hashToUnit(hashWords(ix, iy, s.seed, 0x6e6f6973u + c)) - 0.5f;
     if (s.jitter == JitterMode::Halton)
-        halton_offset = hashWords(x, y, s.seed, 0x68616c74u) % s.sequence_2n->size();
+        halton_offset = hashWords(ix, iy, s.seed, 0x68616c74u) % s.sequence_2n->size();
     const uint32_t n = tr.samples->size();
     const float t_first = tr.segs.front().t0, t_last = tr.segs.back().t1;
     cnt.rays += n;
@@ -234,7 +239,7 @@ void beginRays(const Tracer& tr, uint32_t x, uint32_t y, RayState* rays, TileCou
     for (uint32_t k = 0; k < n; ++k) {
         RayState& ray = rays[k];
         if (!shared) {
-            const LensSample ls = jitteredSample(tr, x, y, k, noise, halton_offset);
+            const LensSample ls = jitteredSample(tr, ix, iy, k, noise, halton_offset);
             const glm::vec2 w(-ls.position.x, ls.position.y);
             ray = RayState{ls, w, cone_offsets ? w + cone_offsets[k] : w};
             ray.t_end = t_last;
@@ -511,7 +516,7 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
     if (sum.v[3] > 0.0) {
         sum.mean(out);
     } else { // every ray left the image: the pinhole colour
-        const size_t i = (size_t(y) * tr.width + x) * 4;
+        const size_t i = (size_t(y - tr.guard) * tr.image_width + (x - tr.guard)) * 4;
         out[0] = tr.pinhole->color[i];
         out[1] = tr.pinhole->color[i + 1];
         out[2] = tr.pinhole->color[i + 2];
@@ -659,19 +664,21 @@ void probePixel(const Tracer& tr, uint32_t x, uint32_t y, MultiviewPixelProbe& o
     out = MultiviewPixelProbe{};
     out.x = x, out.y = y;
     out.rays.resize(n);
-    // The frame's tile around the pixel and its layers (the same per-tile culling).
-    const uint32_t ts = tr.settings->tile_size;
-    const uint32_t x0 = x / ts * ts, y0 = y / ts * ts;
+    // The frame's tile around the pixel and its layers (the same per-tile culling), in the
+    // layers' coordinates.
+    const uint32_t ts = tr.settings->tile_size, g = tr.guard;
+    const uint32_t x0 = g + x / ts * ts, y0 = g + y / ts * ts;
     TileCounters cnt;
     std::array<uint32_t, raster::kMaxLayers> tile_layers{};
-    const uint32_t count = tileLayers(tr, x0, std::min(x0 + ts, tr.width), y0,
-                                      std::min(y0 + ts, tr.height), tile_layers.data(), cnt);
+    const uint32_t count =
+        tileLayers(tr, x0, std::min(x0 + ts, g + tr.image_width), y0,
+                   std::min(y0 + ts, g + tr.image_height), tile_layers.data(), cnt);
     // The pixel alone, as its tile traces it (each pixel's rays are independent of the others').
     std::vector<RayState> rays(n);
     PixelLayers pixel_layers;
     ProbeRecorder rec{out, {}, nullptr, 0, {}};
-    traceTile(tr, x, x + 1, y, y + 1, tile_layers.data(), count, rays.data(), &pixel_layers,
-              nullptr, cnt, rec);
+    traceTile(tr, g + x, g + x + 1, g + y, g + y + 1, tile_layers.data(), count, rays.data(),
+              &pixel_layers, nullptr, cnt, rec);
     out.layers.resize(m);
     for (uint32_t l = 0; l < m; ++l) {
         const PixelLayers& pl = rec.pixel_layers;

@@ -155,7 +155,10 @@ struct Tracer {
     const raster::Frame* pinhole = nullptr;
     const raster::SurfaceShader* shader = nullptr; // view-dependent shading (§5)
     std::vector<LayerSeg> segs;
-    uint32_t width = 0, height = 0;
+    uint32_t width = 0, height = 0; // the layers': the image and its guard band
+    // The output image's pixel (x, y) is the layers' (x + guard, y + guard)
+    // (MultiviewSettings::guard_band_px); the tracer works in the layers' coordinates.
+    uint32_t guard = 0, image_width = 0, image_height = 0;
     float coc_a = 0.0f, coc_b = 0.0f; // C(D) = coc_a + coc_b * D
     // With a shared sample set and the scan (RayPath): path k * segs.size() + l is ray k through
     // layer l's whole segment; empty otherwise.
@@ -291,13 +294,14 @@ using TraceTileFn = void (*)(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_
                              PixelLayers* pixel_layers, float* rgba, TileCounters& cnt);
 TraceTileFn traceTileFor(bool simd);
 
-// The layers the rays of output tile [x0, x1) x [y0, y1) visit, front to back, into `out`
-// (raster::kMaxLayers entries), and their count: the non-empty layers, less those with nothing
-// in reach of the whole tile (one N-buffer query each, §4.3; counted in cnt.culled_tile).
+// The layers the rays of output tile [x0, x1) x [y0, y1) (in the layers' coordinates) visit, front
+// to back, into `out` (raster::kMaxLayers entries), and their count: the non-empty layers, less
+// those with nothing in reach of the whole tile (one N-buffer query each, §4.3; counted in
+// cnt.culled_tile).
 uint32_t tileLayers(const Tracer& tr, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
                     uint32_t* out, TileCounters& cnt);
 
-// probeMultiview's tracing (pixel (x, y) inside the image): the pixel's tile layers and its
+// probeMultiview's tracing (pixel (x, y) of the output image): the pixel's tile layers and its
 // rays traced by the baseline traceTile with a recorder into `out`.
 void probePixel(const Tracer& tr, uint32_t x, uint32_t y, MultiviewPixelProbe& out);
 

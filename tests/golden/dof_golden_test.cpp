@@ -52,9 +52,13 @@ std::vector<DofCase> dofCases() {
     const std::vector<std::string> ml = {"--method", "multilayer"};
     const std::vector<std::string> accum = {"--method", "accum", "--samples", "16"};
     // The choices of Lee et al. 2009 where focal's defaults differ (docs/dof/multiview.md).
-    const std::vector<std::string> mv_paper = {
-        "--traversal", "false-position", "--bound-init",  "on",  "--jitter",      "noise",
-        "--offscreen", "discard",        "--cone-misses", "off", "--cone-centre", "sample"};
+    const std::vector<std::string> mv_paper = {"--traversal",   "false-position",
+                                               "--bound-init",  "on",
+                                               "--jitter",      "noise",
+                                               "--offscreen",   "discard",
+                                               "--cone-misses", "off",
+                                               "--cone-centre", "sample",
+                                               "--guard-band",  "0"};
     // The choices of Selgrad et al. 2015 where focal's defaults differ (docs/dof/multilayer.md).
     const std::vector<std::string> ml_paper = {"--level-filter", "box", "--merge-depth", "nearest",
                                                "--additive-gap", "inf", "--skip-hidden", "off",

@@ -211,6 +211,15 @@ struct MultiviewSettings {
     JitterMode jitter = JitterMode::None;
     uint32_t seed = 0; // jitter key
     OffscreenPolicy offscreen = OffscreenPolicy::Clamp;
+    // §4.3, "Handling Off-Screen Pixels": the paper's other remedy for rays that leave the
+    // image, "a decomposition of the scene ... with a viewport that encompasses all lens rays".
+    // The layers are rendered over the image and a band around it as wide as the largest
+    // visible |C(d)| (rounded up: how far a ray from the lens rim moves), at most this many
+    // pixels; the band has the image's f_px, so the focal plane is as sharp as without it. A ray
+    // near the border then reads what the scene holds beside the image instead of the border
+    // texels (Clamp) or nothing (Discard). 0: the layers cover the image alone (the paper's
+    // choice); docs/multiview.md, "Off-screen rays".
+    float guard_band_px = 64.0f;
     bool view_dependent = false; // §5: shade each hit from its own lens point (needs G-buffer)
     ConeShading cone_shading = ConeShading::Footprint; // with cone && (view_dependent || env)
     const EnvironmentMap* env_map = nullptr;           // §5 reflections (implies a G-buffer)
@@ -234,6 +243,7 @@ struct MultiviewStats {
     uint32_t layers = 0;               // M
     uint32_t layers_empty = 0;         // layers with no fragment (skipped entirely)
     float delta_px = 0.0f;             // spacing used
+    uint32_t guard_band_px = 0;        // the band the layers were rendered with (guard_band_px)
     bool budget_limited = false;       // the spacing needed more than raster::kMaxLayers layers
     float d_near = 0.0f, d_far = 0.0f; // visible depth range (§4.1)
     float lambda = 0.0f;         // mean nearest-neighbour distance of the lens samples (§4.4)
@@ -339,9 +349,11 @@ struct ShadingInputs {
 };
 
 // §4.3-§5 on given layers: traces every pixel's lens rays and writes linear RGBA into `rgba`
-// (resized to width*height*4, alpha 1). `pinhole` supplies the colour of pixels whose rays were
-// all discarded; `background` is what rays that miss every layer see. Fails on invalid settings
-// (messages name the options) or mismatched sizes.
+// (resized to width*height*4, alpha 1). `pinhole` (the view's size) supplies the colour of pixels
+// whose rays were all discarded; `background` is what rays that miss every layer see. `layers`
+// cover the view's image, or the image and a guard band of G pixels on every side (rendered
+// through guardedView(view, G): G is half the difference of their widths, and of their heights).
+// Fails on invalid settings (messages name the options) or mismatched sizes.
 raster::Result<MultiviewStats>
 synthesizeMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
                     const raster::Frame& pinhole, const raster::LayeredTarget& layers,
@@ -363,6 +375,11 @@ raster::Status probeMultiview(const raster::View& view, const ThinLens& lens,
                               const MultiviewScratch& scratch, uint32_t x, uint32_t y,
                               MultiviewPixelProbe& out);
 
+// The view of the image and a band of `guard` pixels on every side (MultiviewSettings::
+// guard_band_px): the same eye, axes and f_px, the image grown by 2 * guard in width and height
+// around the same centre, so its pixel (x + guard, y + guard) is the view's pixel (x, y).
+raster::View guardedView(const raster::View& view, uint32_t guard);
+
 // Renders the pinhole view into the frame. With `depth_only` only the frame's depth buffers are
 // read (raster::RenderOptions::depth_only may serve): renderMultiview asks for the colour too
 // only when the pinhole image is, or may be, part of its output.
@@ -371,13 +388,14 @@ using PinholeFn =
 using LayersFn = std::function<raster::Status(const raster::View&, const raster::LayeredTargetDesc&,
                                               raster::LayeredTarget&)>;
 
-// The whole method: pinhole render (visible depth range, §4.1), layered render (§4.2), then
-// synthesizeMultiview. When the lens cannot change the image (MultiviewStats::skipped) the output
-// is the pinhole frame. The pinhole is rendered for its depth only when no pixel can take its
-// colour (OffscreenPolicy::Clamp and every lens sample of positive weight), so `pinhole_out`'s
-// colour is then not the pinhole image. `rgba` as above. `pinhole_out`, `layers_out` and `scratch`
-// (optional) are the caller's: kept from one frame to the next, their buffers are resized in place
-// rather than allocated again (the same bytes as fresh ones).
+// The whole method: pinhole render (visible depth range, §4.1), layered render (§4.2, through
+// guardedView with the settings' guard band), then synthesizeMultiview. When the lens cannot change
+// the image (MultiviewStats::skipped) the output is the pinhole frame. The pinhole is rendered for
+// its depth only when no pixel can take its colour (OffscreenPolicy::Clamp and every lens sample of
+// positive weight), so `pinhole_out`'s colour is then not the pinhole image. `rgba` as above.
+// `pinhole_out`, `layers_out` and `scratch` (optional) are the caller's: kept from one frame to the
+// next, their buffers are resized in place rather than allocated again (the same bytes as fresh
+// ones).
 raster::Result<MultiviewStats>
 renderMultiview(const raster::View& view, const ThinLens& lens, const LensSampleSet& samples,
                 const MultiviewSettings& settings, const ShadingInputs& shading,
