@@ -366,7 +366,11 @@ renderMultiview(const raster::View& view, const ThinLens& lens, const LensSample
     raster::LayeredTarget local_layers;
     raster::LayeredTarget& layers = layers_out ? *layers_out : local_layers;
     // §4.3's viewport that encompasses the lens rays: a ray from the lens rim moves |C(d)| px.
-    const uint32_t guard = uint32_t(std::min(settings.guard_band_px, std::ceil(coc.max_abs_px)));
+    // A band the rasterizer cannot take (a side past its limit, a field of view near 180°) is
+    // narrowed until it can.
+    uint32_t guard = uint32_t(std::min(settings.guard_band_px, std::ceil(coc.max_abs_px)));
+    while (guard > 0 && !raster::validate(guardedView(view, guard)).ok())
+        guard /= 2;
     t0 = Clock::now();
     if (Status st = render_layers(guardedView(view, guard), fs.desc, layers); !st.ok())
         return st;

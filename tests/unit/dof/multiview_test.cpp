@@ -485,6 +485,25 @@ TEST(Multiview, GuardBandShowsWhatLiesBesideTheImage) {
     EXPECT_EQ(runMultiview(c.scene, c.view, c.lens, samples, narrow).stats.guard_band_px, 4u);
 }
 
+TEST(Multiview, GuardBandNarrowsToAViewTheRasterizerTakes) {
+    // A 177-degree field of view (f_px = 0.62) and a lens that blurs a near square (d = 2, about
+    // 25 px wide) by about 20 px: a 20 px band would need a field of view past the rasterizer's
+    // limit (raster::validate, 3.1 rad), so the band is narrowed until its view is valid (5 px),
+    // and the frame renders.
+    BarCase c = barCase(5.0f, 10.0f);
+    addQuad(c.scene, -40.0f, -40.0f, 40.0f, 40.0f, 2.0f, c.green);
+    c.view.yfov = 3.09f;
+    c.lens = dof::makeThinLens(c.view, 66.0f, 100.0f);
+    MvRun run;
+    const raster::Result<dof::MultiviewStats> r =
+        tryMultiview(c.scene, c.view, c.lens, makeSamples(8), dof::MultiviewSettings{}, 0, run);
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    EXPECT_FALSE(r->skipped);
+    EXPECT_EQ(r->guard_band_px, 5u);
+    EXPECT_TRUE(raster::validate(dof::guardedView(c.view, r->guard_band_px)).ok());
+    EXPECT_FALSE(raster::validate(dof::guardedView(c.view, 2 * r->guard_band_px)).ok());
+}
+
 TEST(Multiview, ScanAndFalsePositionAgreeAndScanIsCloserToAccum) {
     // On the paper's height field (infinite thickness) the exact scan and the false position
     // meet the same surfaces; where the linear model misses a crossing (slanted and thin
