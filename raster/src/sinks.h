@@ -109,6 +109,19 @@ struct LayerSink {
         if (wants_gbuffer)
             target.gbuffer[i] = f.g;
     }
+    // The light queue's halves of write (FrameSink) for a sink whose lit, non-BLEND fragments
+    // each go to one layer: MaxVertexDepth routing (the overlapped copies are made after the
+    // tile) and no G-buffer (the queue does not carry the fragment's sample). queue() stores the
+    // depth in the triangle's layer and says where the colour goes.
+    bool queuesLight() const {
+        return target.desc.routing == LayerRouting::MaxVertexDepth && !wants_gbuffer;
+    }
+    size_t queue(size_t pixel, float z, uint32_t) {
+        const size_t i = target.index(triangle_layer, pixel);
+        target.depth.store(i, z);
+        return i;
+    }
+    void writeQueued(size_t i, glm::vec4 c) { target.color.store(i, c); }
     void write(size_t pixel, const Fragment& f) {
         if (f.blend) {
             writeLayer(layerOf(target.desc, f.distance), pixel, f);

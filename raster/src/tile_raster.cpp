@@ -78,12 +78,17 @@ void fillFragmentTriangle(const ShadeContext& shade, TriangleRaster& tr) {
 // still ends with its later triangle's colour. The batch is shaded when full, when the
 // lighting constants change, before any colour written without it (unlit or BLEND lanes, which
 // may land on a queued pixel) and at the end of the tile. For the sinks that can store a
-// fragment in these two halves: the frame and the fragment lists (not the layers, whose copies
-// into overlapping layers need the colour).
+// fragment in these two halves: the frame, the fragment lists and the layers when each fragment
+// goes to one layer (LayerSink::queuesLight; copies into several layers need the colour).
 template <class Sink> constexpr bool kBatchesLight = requires(Sink& s) {
     { s.queue(size_t{}, 0.0f, uint32_t{}) } -> std::same_as<size_t>;
     s.writeQueued(size_t{}, glm::vec4{});
 };
+template <class Sink> bool queuesLight(const Sink& sink) {
+    if constexpr (requires { sink.queuesLight(); })
+        return sink.queuesLight();
+    return true;
+}
 
 // Pairs with at most this many lit lanes are packed into the queue lane by lane.
 constexpr uint32_t kQueuedLanes = 4;
@@ -208,8 +213,9 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         fillFragmentTriangle(ctx.shade, tr);
     const bool unlit = isUnlit(ctx.shade, m);
     const bool blend = m.alpha_mode == AlphaMode::Blend;
+    [[maybe_unused]] const bool queued = !unlit && !blend && queuesLight(sink);
     if constexpr (kBatchesLight<Sink>) {
-        if (!unlit && !blend && laneCount(tested) > kQueuedLanes) {
+        if (queued && laneCount(tested) > kQueuedLanes) {
             // A whole block of the queue, written in place by the fragment kernel.
             useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
             int start = (batch.count + kLightLanes - 1) / kLightLanes * kLightLanes;
@@ -245,7 +251,7 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         return;
     counters.passed += laneCount(passed);
     if constexpr (kBatchesLight<Sink>) {
-        if (!unlit && !blend) {
+        if (queued) {
             // At most kQueuedLanes lanes: packed into the queue.
             useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
             for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {

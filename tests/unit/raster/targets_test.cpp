@@ -210,6 +210,31 @@ TEST(LayeredTarget, BitIdenticalAcrossThreadsAndTiles) {
     }
 }
 
+TEST(LayeredTarget, LightQueueGivesTheBytesOfFragmentsShadedOneByOne) {
+    // Lit fragments routed to one layer (MaxVertexDepth) wait in the tile raster's light queue,
+    // their depth stored at once and their colour when a batch of 16 is shaded (LayerSink::
+    // queuesLight); with a G-buffer, which the queue does not carry, each quad pair is shaded
+    // and written whole. Both must leave the same colour and depth in every layer, overlapped
+    // copies included, on demo (textured, lit and emissive materials).
+    raster::Result<raster::Scene> s = scenes::makeBuiltinScene("demo");
+    ASSERT_TRUE(s.ok());
+    const raster::View v = raster::viewFromCamera(s->cameras[0], 160, 120);
+    raster::LayeredTargetDesc queued;
+    queued.bounds = {0.5f, 2.0f, 4.0f, 6.0f, 10.0f, 100.0f};
+    queued.routing = LayerRouting::MaxVertexDepth;
+    queued.overlap = 0.1f;
+    raster::LayeredTargetDesc whole = queued;
+    whole.gbuffer = true;
+    for (uint32_t threads : {0u, 2u}) {
+        const raster::LayeredTarget a = layers(*s, v, queued, threads, 16);
+        const raster::LayeredTarget b = layers(*s, v, whole, threads, 16);
+        ASSERT_FALSE(a.color.float32.empty());
+        EXPECT_EQ(a.color.float32, b.color.float32) << threads;
+        EXPECT_EQ(a.depth.float32, b.depth.float32) << threads;
+        EXPECT_EQ(a.transparent_color.float32, b.transparent_color.float32) << threads;
+    }
+}
+
 TEST(LayeredTarget, HalfAndUnorm16StorageStayWithinTheirPrecision) {
     const raster::Scene s = stackScene(true);
     const raster::View v = stackView();
