@@ -310,32 +310,36 @@ BarCase barsAndPane() {
 TEST(Multiview, CullingIsLossless) {
     // Culling skips the height-field tests and the missed rays' cones only where they cannot
     // see a texel. A BLEND pane (its own plane, in the N-buffer too), both off-screen policies,
-    // one-pixel layers (short precomputed paths) and two layers (long paths, culled per ray).
+    // one-pixel layers (short precomputed paths) and two layers (long paths, culled per ray),
+    // with and without a guard band (without one the rays leave the image and the culling
+    // windows are clamped at its border).
     const BarCase c = barsAndPane();
     const dof::LensSampleSet samples = makeSamples(24);
-    for (dof::Traversal traversal : {dof::Traversal::Scan, dof::Traversal::FalsePosition})
-        for (dof::JitterMode jitter : {dof::JitterMode::None, dof::JitterMode::Noise})
-            for (dof::OffscreenPolicy offscreen :
-                 {dof::OffscreenPolicy::Clamp, dof::OffscreenPolicy::Discard})
-                for (uint32_t layers : {0u, 2u}) {
-                    dof::MultiviewSettings on;
-                    on.layer_spacing_px = 1.0f;
-                    on.layers = layers;
-                    on.traversal = traversal;
-                    on.jitter = jitter; // per-pixel samples: every path is walked per pixel
-                    on.offscreen = offscreen;
-                    dof::MultiviewSettings off = on;
-                    off.culling = false;
-                    const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
-                    const MvRun b = runMultiview(c.scene, c.view, c.lens, samples, off);
-                    EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
-                    EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile +
-                                  a.stats.layer_culled_ray,
-                              0u);
-                    EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
-                    EXPECT_GT(a.stats.cone_missed, 0u);
-                    EXPECT_EQ(a.stats.cone_missed, b.stats.cone_missed);
-                }
+    for (float guard : {0.0f, 64.0f})
+        for (dof::Traversal traversal : {dof::Traversal::Scan, dof::Traversal::FalsePosition})
+            for (dof::JitterMode jitter : {dof::JitterMode::None, dof::JitterMode::Noise})
+                for (dof::OffscreenPolicy offscreen :
+                     {dof::OffscreenPolicy::Clamp, dof::OffscreenPolicy::Discard})
+                    for (uint32_t layers : {0u, 2u}) {
+                        dof::MultiviewSettings on;
+                        on.layer_spacing_px = 1.0f;
+                        on.layers = layers;
+                        on.traversal = traversal;
+                        on.jitter = jitter; // per-pixel samples: every path is walked per pixel
+                        on.offscreen = offscreen;
+                        on.guard_band_px = guard;
+                        dof::MultiviewSettings off = on;
+                        off.culling = false;
+                        const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
+                        const MvRun b = runMultiview(c.scene, c.view, c.lens, samples, off);
+                        EXPECT_EQ(hashFloats(a.frame.color), hashFloats(b.frame.color));
+                        EXPECT_GT(a.stats.layer_culled_pixel + a.stats.layer_culled_tile +
+                                      a.stats.layer_culled_ray,
+                                  0u);
+                        EXPECT_LT(a.stats.layer_tests, b.stats.layer_tests);
+                        EXPECT_GT(a.stats.cone_missed, 0u);
+                        EXPECT_EQ(a.stats.cone_missed, b.stats.cone_missed);
+                    }
 }
 
 TEST(Multiview, PrecomputedPathsGiveTheSameBytes) {
@@ -442,7 +446,11 @@ TEST(Multiview, MissedConesOffTheImageReadItsBorder) {
     const dof::ThinLens lens = dof::makeThinLens(view, 10.0f, 100.0f);
     const dof::LensSampleSet samples = makeSamples(32);
     const raster::Frame ref = renderAccum(scene, view, lens, makeSamples(256));
-    const MvRun run = runMultiview(scene, view, lens, samples, dof::MultiviewSettings{});
+    // The layers cover the image alone (no guard band, which would hold the strip's
+    // continuation), so the rays and cones that leave the image read its border.
+    dof::MultiviewSettings image_only;
+    image_only.guard_band_px = 0.0f;
+    const MvRun run = runMultiview(scene, view, lens, samples, image_only);
     // Mean error in the last six columns against six columns well inside the image, rows
     // 12-35 (the strip's blur). Measured: 0.0035 and 0.0036; 0.0093 at the border when
     // off-image cones were skipped.
@@ -450,7 +458,7 @@ TEST(Multiview, MissedConesOffTheImageReadItsBorder) {
     const double inner = boxError(run.frame, ref, 40, 12, 46, 36);
     EXPECT_LT(border, 1.5 * inner);
     EXPECT_GT(run.stats.cone_missed, 0u);
-    dof::MultiviewSettings off;
+    dof::MultiviewSettings off = image_only;
     off.culling = false; // the border lookups stay inside the culling windows
     EXPECT_EQ(hashFloats(run.frame.color),
               hashFloats(runMultiview(scene, view, lens, samples, off).frame.color));
