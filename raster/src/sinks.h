@@ -40,6 +40,7 @@ struct FrameSink {
     // The two halves of write for a lit, non-BLEND fragment, stored apart by the tile raster's
     // light queue: queue() stores what the next fragments' tests read (here the depth) and
     // says where the colour goes, writeQueued() stores the colour once it is shaded.
+    bool queuesLight() const { return true; }
     size_t queue(size_t pixel, float z, uint32_t) {
         writeDepth(pixel, z);
         return pixel;
@@ -206,6 +207,7 @@ struct ListSink {
     // The light queue's halves of write (FrameSink): the node and its key at once, in
     // primitive order, its colour when shaded (node order is what decides; colours are read
     // only by the resolve, after the tile).
+    bool queuesLight() const { return true; }
     size_t queue(size_t pixel, float z, uint32_t primitive_id) {
         writeNode(pixel, glm::vec4(0.0f), z, primitive_id);
         return pool.size() - 1;

@@ -77,18 +77,9 @@ void fillFragmentTriangle(const ShadeContext& shade, TriangleRaster& tr) {
 // its colour when the batch is shaded (`writeQueued`), in queue order, so a pixel queued twice
 // still ends with its later triangle's colour. The batch is shaded when full, when the
 // lighting constants change, before any colour written without it (unlit or BLEND lanes, which
-// may land on a queued pixel) and at the end of the tile. For the sinks that can store a
-// fragment in these two halves: the frame, the fragment lists and the layers when each fragment
-// goes to one layer (LayerSink::queuesLight; copies into several layers need the colour).
-template <class Sink> constexpr bool kBatchesLight = requires(Sink& s) {
-    { s.queue(size_t{}, 0.0f, uint32_t{}) } -> std::same_as<size_t>;
-    s.writeQueued(size_t{}, glm::vec4{});
-};
-template <class Sink> bool queuesLight(const Sink& sink) {
-    if constexpr (requires { sink.queuesLight(); })
-        return sink.queuesLight();
-    return true;
-}
+// may land on a queued pixel) and at the end of the tile. Every sink stores a fragment in
+// these two halves when its queuesLight() says so: the frame and the fragment lists always, the
+// layers when each fragment goes to one layer (copies into several layers need the colour).
 
 // Pairs with at most this many lit lanes are packed into the queue lane by lane.
 constexpr uint32_t kQueuedLanes = 4;
@@ -213,34 +204,32 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         fillFragmentTriangle(ctx.shade, tr);
     const bool unlit = isUnlit(ctx.shade, m);
     const bool blend = m.alpha_mode == AlphaMode::Blend;
-    [[maybe_unused]] const bool queued = !unlit && !blend && queuesLight(sink);
-    if constexpr (kBatchesLight<Sink>) {
-        if (queued && laneCount(tested) > kQueuedLanes) {
-            // A whole block of the queue, written in place by the fragment kernel.
-            useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
-            int start = (batch.count + kLightLanes - 1) / kLightLanes * kLightLanes;
-            if (start == LightBatch::kLanes) {
-                shadeBatch(ctx, batch, sink);
-                start = 0;
-            }
-            const uint32_t passed =
-                ctx.fragment_kernel(tr.frag, q.persp, base_textured ? base_texel : nullptr,
-                                    emissive_textured ? emissive_texel : nullptr, tested,
-                                    batch.blockOf(start), batch.alpha + start);
-            if (passed == 0)
-                return;
-            counters.passed += laneCount(passed);
-            for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
-                const int l = std::countr_zero(rest);
-                batch.handle[start + l] =
-                    sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
-            }
-            batch.queued |= passed << start;
-            batch.count = start + kLightLanes;
-            if (batch.count == LightBatch::kLanes)
-                shadeBatch(ctx, batch, sink);
-            return;
+    const bool queued = !unlit && !blend && sink.queuesLight();
+    if (queued && laneCount(tested) > kQueuedLanes) {
+        // A whole block of the queue, written in place by the fragment kernel.
+        useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
+        int start = (batch.count + kLightLanes - 1) / kLightLanes * kLightLanes;
+        if (start == LightBatch::kLanes) {
+            shadeBatch(ctx, batch, sink);
+            start = 0;
         }
+        const uint32_t passed =
+            ctx.fragment_kernel(tr.frag, q.persp, base_textured ? base_texel : nullptr,
+                                emissive_textured ? emissive_texel : nullptr, tested,
+                                batch.blockOf(start), batch.alpha + start);
+        if (passed == 0)
+            return;
+        counters.passed += laneCount(passed);
+        for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
+            const int l = std::countr_zero(rest);
+            batch.handle[start + l] =
+                sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
+        }
+        batch.queued |= passed << start;
+        batch.count = start + kLightLanes;
+        if (batch.count == LightBatch::kLanes)
+            shadeBatch(ctx, batch, sink);
+        return;
     }
     LightLanes light;
     alignas(32) float alpha[kQuadLanes];
@@ -250,31 +239,28 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     if (passed == 0)
         return;
     counters.passed += laneCount(passed);
-    if constexpr (kBatchesLight<Sink>) {
-        if (queued) {
-            // At most kQueuedLanes lanes: packed into the queue.
-            useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
-            for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
-                const int l = std::countr_zero(rest);
-                const int i = batch.count++, j = i % kLightLanes;
-                batch.handle[i] =
-                    sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
-                LightLanes& b = batch.blockOf(i);
-                for (int c = 0; c < 3; ++c) {
-                    b.albedo[c][j] = light.albedo[c][l];
-                    b.emissive[c][j] = light.emissive[c][l];
-                    b.world[c][j] = light.world[c][l];
-                    b.normal[c][j] = light.normal[c][l];
-                }
-                batch.alpha[i] = alpha[l];
-                batch.queued |= 1u << i;
-                if (batch.count == LightBatch::kLanes)
-                    shadeBatch(ctx, batch, sink);
+    if (queued) {
+        // At most kQueuedLanes lanes: packed into the queue.
+        useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
+        for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
+            const int l = std::countr_zero(rest);
+            const int i = batch.count++, j = i % kLightLanes;
+            batch.handle[i] = sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
+            LightLanes& b = batch.blockOf(i);
+            for (int c = 0; c < 3; ++c) {
+                b.albedo[c][j] = light.albedo[c][l];
+                b.emissive[c][j] = light.emissive[c][l];
+                b.world[c][j] = light.world[c][l];
+                b.normal[c][j] = light.normal[c][l];
             }
-            return;
+            batch.alpha[i] = alpha[l];
+            batch.queued |= 1u << i;
+            if (batch.count == LightBatch::kLanes)
+                shadeBatch(ctx, batch, sink);
         }
-        shadeBatch(ctx, batch, sink); // queued colours land before these
+        return;
     }
+    shadeBatch(ctx, batch, sink); // queued colours land before these
     if (!unlit) {
         const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
         ctx.shade.light_kernel(ctx.shade.lights, ctx.shade.light_count,
@@ -395,8 +381,7 @@ void rasterizeTileImpl(const RasterContext& ctx, uint32_t tile, Sink& sink,
                                   local);
             }
         }
-    if constexpr (kBatchesLight<Sink>)
-        shadeBatch(ctx, batch, sink);
+    shadeBatch(ctx, batch, sink);
     counters.covered += local.covered;
     counters.passed += local.passed;
     counters.rejected += local.rejected;
