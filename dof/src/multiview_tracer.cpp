@@ -87,7 +87,7 @@ struct NoRecorder {
     static constexpr bool kOn = false;
     // Where pixel (x, y)'s result goes: the frame's image.
     static float* pixelOut(float* rgba, const Tracer& tr, uint32_t x, uint32_t y, bool) {
-        return rgba + (size_t(y - tr.guard) * tr.image_width + (x - tr.guard)) * 4;
+        return rgba + tr.imagePixel(x, y) * 4;
     }
 };
 
@@ -516,7 +516,7 @@ void endPixel(const Tracer& tr, uint32_t x, uint32_t y, const RayState* rays, fl
     if (sum.v[3] > 0.0) {
         sum.mean(out);
     } else { // every ray left the image: the pinhole colour
-        const size_t i = (size_t(y - tr.guard) * tr.image_width + (x - tr.guard)) * 4;
+        const size_t i = tr.imagePixel(x, y) * 4;
         out[0] = tr.pinhole->color[i];
         out[1] = tr.pinhole->color[i + 1];
         out[2] = tr.pinhole->color[i + 2];

@@ -200,6 +200,10 @@ struct Tracer {
     }
 
     float cocOf(float t) const { return coc_a + coc_b * t; }
+    // The output image's pixel index of the layers' pixel (x, y), inside the image.
+    size_t imagePixel(uint32_t x, uint32_t y) const {
+        return size_t(y - guard) * image_width + (x - guard);
+    }
     bool inImage(float px, float py) const {
         return px >= 0.0f && py >= 0.0f && px < float(width) && py < float(height);
     }
