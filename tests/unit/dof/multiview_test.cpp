@@ -307,6 +307,17 @@ BarCase barsAndPane() {
     return c;
 }
 
+// The sweeps' settings on barsAndPane(): one-pixel layers (layers = 0, delta = 1 px: short
+// precomputed paths) or `layers` layers (long paths), the off-screen policy and the guard band.
+dof::MultiviewSettings barsSettings(float guard, dof::OffscreenPolicy offscreen, uint32_t layers) {
+    dof::MultiviewSettings s;
+    s.layer_spacing_px = 1.0f;
+    s.layers = layers;
+    s.offscreen = offscreen;
+    s.guard_band_px = guard;
+    return s;
+}
+
 TEST(Multiview, CullingIsLossless) {
     // Culling skips the height-field tests and the missed rays' cones only where they cannot
     // see a texel. A BLEND pane (its own plane, in the N-buffer too), both off-screen policies,
@@ -321,13 +332,9 @@ TEST(Multiview, CullingIsLossless) {
                 for (dof::OffscreenPolicy offscreen :
                      {dof::OffscreenPolicy::Clamp, dof::OffscreenPolicy::Discard})
                     for (uint32_t layers : {0u, 2u}) {
-                        dof::MultiviewSettings on;
-                        on.layer_spacing_px = 1.0f;
-                        on.layers = layers;
+                        dof::MultiviewSettings on = barsSettings(guard, offscreen, layers);
                         on.traversal = traversal;
                         on.jitter = jitter; // per-pixel samples: every path is walked per pixel
-                        on.offscreen = offscreen;
-                        on.guard_band_px = guard;
                         dof::MultiviewSettings off = on;
                         off.culling = false;
                         const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on);
@@ -354,11 +361,7 @@ TEST(Multiview, PrecomputedPathsGiveTheSameBytes) {
         for (dof::OffscreenPolicy offscreen :
              {dof::OffscreenPolicy::Discard, dof::OffscreenPolicy::Clamp})
             for (uint32_t layers : {0u, 2u}) {
-                dof::MultiviewSettings on;
-                on.layer_spacing_px = 1.0f;
-                on.layers = layers;
-                on.offscreen = offscreen;
-                on.guard_band_px = guard;
+                const dof::MultiviewSettings on = barsSettings(guard, offscreen, layers);
                 dof::MultiviewSettings off = on;
                 off.precompute_paths = false;
                 const MvRun a = runMultiview(c.scene, c.view, c.lens, samples, on, 2);
