@@ -3,7 +3,9 @@
 // texture.cpp's sampleLevel in the same order, so the results are its bits; branches only on
 // what the lanes share. No calls to inline library templates (see quad_kernel.inl). The table
 // loads (texel words, the sRGB table) go through gatherLanes: AVX2 gathers in the AVX2 build,
-// which loads a level's decoded texels instead where it has them (loadLinearLanes).
+// which loads a level's decoded texels instead where it has them (loadLinearLanes). The AVX2 file
+// asks for its intrinsics with FOCAL_TEXTURE_KERNEL_AVX2 (not __AVX2__, so that the reference
+// stays scalar under -march flags that enable AVX2).
 #ifndef FOCAL_TEXTURE_KERNEL_NAME
 #error "define FOCAL_TEXTURE_KERNEL_NAME before including texture_kernel.inl"
 #endif
@@ -24,10 +26,33 @@ inline double texelCoordLane(float u, double size) {
     return __builtin_fabs(d) <= double(__FLT_MAX__) ? x : 0.0;
 }
 
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
+inline __m256i loadLanes(const int32_t* p) {
+    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+}
+inline void storeLanes(int32_t* p, __m256i v) {
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v);
+}
+#endif
+
 // texture.cpp's wrapIndex of i and of i + 1, for |i| <= 2^30 and 0 < n <= kTextureKernelMaxSide.
 // The period's multiple is floor(i / period) in double, exact: the quotient's rounding error
 // (< 2^-22) is smaller than its distance (>= 1/period) from the next integer above.
+// The AVX2 build writes these integer lane loops with intrinsics: GCC 12 leaves them scalar (a
+// quarter of the kernel's instructions on demo, callgrind); integers, so the same values.
 inline void wrapLanes(const int32_t* i, int32_t n, Wrap mode, int32_t* w0, int32_t* w1) {
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
+    const __m256i vi = loadLanes(i), last = _mm256_set1_epi32(n - 1);
+    if (mode == Wrap::ClampToEdge) {
+        // a < 0 ? 0 : min(a, n - 1) is max(0, min(a, n - 1)) for n >= 1.
+        const __m256i zero = _mm256_setzero_si256();
+        storeLanes(w0, _mm256_max_epi32(zero, _mm256_min_epi32(vi, last)));
+        storeLanes(w1,
+                   _mm256_max_epi32(
+                       zero, _mm256_min_epi32(_mm256_add_epi32(vi, _mm256_set1_epi32(1)), last)));
+        return;
+    }
+#else
     if (mode == Wrap::ClampToEdge) {
         for (int l = 0; l < kLanes; ++l) {
             const int32_t a = i[l], b = i[l] + 1;
@@ -36,34 +61,55 @@ inline void wrapLanes(const int32_t* i, int32_t n, Wrap mode, int32_t* w0, int32
         }
         return;
     }
+#endif
     const int32_t period = mode == Wrap::Repeat ? n : 2 * n;
     if ((period & (period - 1)) == 0) {
         // A power-of-two period (most textures): i mod period is the low bits of i in two's
-        // complement, the same integer without the division.
-        for (int l = 0; l < kLanes; ++l)
+        // complement, the same integer without the division; so is i + 1's, which is w0 + 1
+        // wrapped to 0 at the period.
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
+        const __m256i low = _mm256_set1_epi32(period - 1);
+        storeLanes(w0, _mm256_and_si256(vi, low));
+        storeLanes(w1, _mm256_and_si256(_mm256_add_epi32(vi, _mm256_set1_epi32(1)), low));
+#else
+        for (int l = 0; l < kLanes; ++l) {
             w0[l] = i[l] & (period - 1);
+            w1[l] = (i[l] + 1) & (period - 1);
+        }
+#endif
     } else {
         const double period_d = double(period);
         for (int l = 0; l < kLanes; ++l)
             w0[l] = i[l] - period * int32_t(__builtin_floor(double(i[l]) / period_d));
+        for (int l = 0; l < kLanes; ++l)
+            w1[l] = w0[l] + 1 == period ? 0 : w0[l] + 1;
     }
-    for (int l = 0; l < kLanes; ++l)
-        w1[l] = w0[l] + 1 == period ? 0 : w0[l] + 1;
-    if (mode == Wrap::MirroredRepeat)
+    if (mode == Wrap::MirroredRepeat) {
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
+        // w < n ? w : period - 1 - w
+        const __m256i top = _mm256_set1_epi32(period - 1), vn = _mm256_set1_epi32(n);
+        const auto mirror = [&](int32_t* w) {
+            const __m256i v = loadLanes(w);
+            storeLanes(w,
+                       _mm256_blendv_epi8(_mm256_sub_epi32(top, v), v, _mm256_cmpgt_epi32(vn, v)));
+        };
+        mirror(w0);
+        mirror(w1);
+#else
         for (int l = 0; l < kLanes; ++l) {
             w0[l] = w0[l] < n ? w0[l] : period - 1 - w0[l];
             w1[l] = w1[l] < n ? w1[l] : period - 1 - w1[l];
         }
+#endif
+    }
 }
 
 // out[l] = table[index[l]] for every lane, each index valid, for any 4-byte T (texel words,
 // the sRGB table's floats): one 8-lane gather of 32-bit words in the AVX2 build (GCC 12 does not
-// vectorize these loads by itself), a lane loop in the scalar reference. The AVX2 file asks for
-// the gathers with FOCAL_TEXTURE_KERNEL_GATHERS (not __AVX2__, so that the reference stays
-// scalar under -march flags that enable AVX2).
+// vectorize these loads by itself), a lane loop in the scalar reference.
 template <class T> void gatherLanes(const T* table, const int32_t* index, T* out) {
     static_assert(sizeof(T) == 4);
-#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
     const __m256i i = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
                         _mm256_i32gather_epi32(reinterpret_cast<const int*>(table), i, 4));
@@ -73,7 +119,7 @@ template <class T> void gatherLanes(const T* table, const int32_t* index, T* out
 #endif
 }
 
-#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
 // The decoded texels at `index` of every lane, channel by channel: eight 16-byte loads (lanes l
 // and l + 4 into the two halves of one register) and a 4x4 transpose within each half.
 inline void loadLinearLanes(const float* linear, const int32_t* index, float (*rgba)[kLanes]) {
@@ -94,9 +140,15 @@ inline void loadLinearLanes(const float* linear, const int32_t* index, float (*r
 inline void fetchLanes(const TextureLevel& level, const float* lut, const int32_t* x,
                        const int32_t* y, float (*rgba)[kLanes]) {
     alignas(32) int32_t index[kLanes];
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
+    storeLanes(index,
+               _mm256_add_epi32(_mm256_mullo_epi32(loadLanes(y), _mm256_set1_epi32(level.width)),
+                                loadLanes(x)));
+#else
     for (int l = 0; l < kLanes; ++l)
         index[l] = y[l] * level.width + x[l];
-#ifdef FOCAL_TEXTURE_KERNEL_GATHERS
+#endif
+#ifdef FOCAL_TEXTURE_KERNEL_AVX2
     if (level.linear) {
         loadLinearLanes(level.linear, index, rgba);
         return;

@@ -12,9 +12,9 @@ namespace raster {
 
 namespace {
 #define FOCAL_TEXTURE_KERNEL_NAME textureKernelAvx2Impl
-#define FOCAL_TEXTURE_KERNEL_GATHERS 1
+#define FOCAL_TEXTURE_KERNEL_AVX2 1
 #include "texture_kernel.inl"
-#undef FOCAL_TEXTURE_KERNEL_GATHERS
+#undef FOCAL_TEXTURE_KERNEL_AVX2
 #undef FOCAL_TEXTURE_KERNEL_NAME
 } // namespace
 
