@@ -78,80 +78,77 @@ bool zeroFootprint(const Image& image, const LevelSelection& sel, const TextureL
 } // namespace
 
 TextureRoles sampledTextureRoles(ShadingMode) {
-    // The base colour and emissive textures are the only texture reads (sampleQuadPair in the
+    // The base colour and emissive textures are the only texture reads (sampleLanes in the
     // tile raster), and every mode makes them (lighting takes metallic and roughness from the
     // material's factors alone).
     return TextureRoles{} | TextureRole::BaseColor | TextureRole::Emissive;
 }
 
-void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& in,
-                    uint32_t lane_mask, bool colour_only, float rgba[4][kTextureLanes]) {
+void prepareQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& in,
+                     QuadPairLookup& out) {
     const Image& image = ctx.scene->images[size_t(ref.image)];
     const Sampler& sampler = samplerOf(*ctx.scene, ref);
-    float lod[2];
     for (int q = 0; q < 2; ++q) {
         const int l0 = 4 * q;
-        lod[q] = levelOfDetail(ref, image, {in.u[l0 + 1] - in.u[l0], in.v[l0 + 1] - in.v[l0]},
-                               {in.u[l0 + 2] - in.u[l0], in.v[l0 + 2] - in.v[l0]});
+        const float lod =
+            levelOfDetail(ref, image, {in.u[l0 + 1] - in.u[l0], in.v[l0 + 1] - in.v[l0]},
+                          {in.u[l0 + 2] - in.u[l0], in.v[l0 + 2] - in.v[l0]});
+        out.sel[q] = selectLevels(image, sampler, ctx.filter, lod);
     }
+    for (int l = 0; l < kTextureLanes; ++l)
+        out.lanes.weight[l] = out.sel[l / 4].weight;
     // KHR_texture_transform: uv' = M (u, v, 1), as glm's mat3 * vec3 computes it (the third
     // term is M[2] * 1, which is M[2]), a lane loop the compiler vectorizes.
     const glm::mat3& m = ref.transform;
-    TextureLanes lanes;
     for (int l = 0; l < kTextureLanes; ++l) {
-        lanes.u[l] = m[0][0] * in.u[l] + m[1][0] * in.v[l] + m[2][0];
-        lanes.v[l] = m[0][1] * in.u[l] + m[1][1] * in.v[l] + m[2][1];
+        out.lanes.u[l] = m[0][0] * in.u[l] + m[1][0] * in.v[l] + m[2][0];
+        out.lanes.v[l] = m[0][1] * in.u[l] + m[1][1] * in.v[l] + m[2][1];
     }
+}
+
+bool sameLevels(const LevelSelection& a, const LevelSelection& b) {
+    return a.level0 == b.level0 && a.level1 == b.level1 && a.filter == b.filter &&
+           a.mix_levels == b.mix_levels;
+}
+
+void sampleLanes(const ShadeContext& ctx, const TextureRef& ref, const LevelSelection& sel,
+                 uint32_t lane_mask, bool colour_only, TextureLanes& lanes) {
+    const Image& image = ctx.scene->images[size_t(ref.image)];
+    // Where the image has blocks of zero texels, lookups that read only those are zero.
+    const bool zeros = colour_only ? image.zero_colour_blocks : image.zero_blocks;
+    if (zeros && zeroFootprint(image, sel, lanes, lane_mask, colour_only)) {
+        for (int k = 0; k < 4; ++k)
+            for (int l = 0; l < kTextureLanes; ++l)
+                lanes.rgba[k][l] = 0.0f;
+        return;
+    }
+    const Sampler& sampler = samplerOf(*ctx.scene, ref);
     // One by one when at most kFewLanes lanes are asked for (with gathers, an AVX2 kernel call
     // costs about as much as 1.3 one-fragment lookups; callgrind on ToyCar, docs/raster.md 8.2)
     // or the image is beyond the kernel's integers.
     constexpr int kFewLanes = 1;
-    // Where the image has blocks of zero texels, lookups that read only those are zero.
-    const bool zeros = colour_only ? image.zero_colour_blocks : image.zero_blocks;
     if (laneCount(lane_mask) <= kFewLanes || !fitsTextureKernel(image.levels[0])) {
         for (int l = 0; l < kTextureLanes; ++l) {
             glm::vec4 c(0.0f); // a lane not asked for is still written (shading.h)
             if (lane_mask & (1u << l)) {
-                const LevelSelection sel = selectLevels(image, sampler, ctx.filter, lod[l / 4]);
-                if (!zeros || !zeroFootprint(image, sel, lanes, 1u << l, colour_only))
-                    c = sampleLevels(image, sampler, sel, {lanes.u[l], lanes.v[l]});
+                LevelSelection lane_sel = sel;
+                lane_sel.weight = lanes.weight[l];
+                c = sampleLevels(image, sampler, lane_sel, {lanes.u[l], lanes.v[l]});
             }
             for (int k = 0; k < 4; ++k)
-                rgba[k][l] = c[k];
+                lanes.rgba[k][l] = c[k];
         }
         return;
     }
-    const LevelSelection sel[2] = {selectLevels(image, sampler, ctx.filter, lod[0]),
-                                   selectLevels(image, sampler, ctx.filter, lod[1])};
-    for (int l = 0; l < kTextureLanes; ++l)
-        lanes.weight[l] = sel[l / 4].weight;
-    // Both quads in one call when they read the same levels the same way (the usual case);
-    // otherwise one call per quad, each keeping its own four lanes.
-    const bool shared = sel[0].level0 == sel[1].level0 && sel[0].level1 == sel[1].level1 &&
-                        sel[0].filter == sel[1].filter && sel[0].mix_levels == sel[1].mix_levels;
-    for (int q = 0; q < (shared ? 1 : 2); ++q) {
-        const int first = shared ? 0 : 4 * q, last = shared ? kTextureLanes : 4 * q + 4;
-        const uint32_t mask = shared ? lane_mask : lane_mask & (0xfu << first);
-        // A quad with no lane asked for, or whose lookups read only zero texels, is not sampled.
-        if (mask == 0 || (zeros && zeroFootprint(image, sel[q], lanes, mask, colour_only))) {
-            for (int k = 0; k < 4; ++k)
-                for (int l = first; l < last; ++l)
-                    rgba[k][l] = 0.0f;
-            continue;
-        }
-        TextureQuery query;
-        query.level[0] = kernelLevel(image.levels[sel[q].level0]);
-        query.level[1] = kernelLevel(image.levels[sel[q].level1]);
-        query.srgb_lut = image.srgb ? srgbDecodeTable() : nullptr;
-        query.wrap_s = sampler.wrap_s;
-        query.wrap_t = sampler.wrap_t;
-        query.nearest = sel[q].filter == Filter::Nearest;
-        query.mix_levels = sel[q].mix_levels;
-        ctx.texture_kernel(query, lanes);
-        for (int k = 0; k < 4; ++k)
-            for (int l = first; l < last; ++l)
-                rgba[k][l] = lanes.rgba[k][l];
-    }
+    TextureQuery query;
+    query.level[0] = kernelLevel(image.levels[sel.level0]);
+    query.level[1] = kernelLevel(image.levels[sel.level1]);
+    query.srgb_lut = image.srgb ? srgbDecodeTable() : nullptr;
+    query.wrap_s = sampler.wrap_s;
+    query.wrap_t = sampler.wrap_t;
+    query.nearest = sel.filter == Filter::Nearest;
+    query.mix_levels = sel.mix_levels;
+    ctx.texture_kernel(query, lanes);
 }
 
 bool isUnlit(const ShadeContext& ctx, const Material& m) {

@@ -38,16 +38,32 @@ struct QuadPairUv {
     alignas(32) float v[kTextureLanes];
 };
 
-// `ref`'s texture (texture transform, level of detail, sampler) at the lanes of a quad pair set
-// in `lanes`: linear RGBA per lane, the same bits as a lookup of that one fragment. Every lane of
-// `rgba` is written (those not asked for with unspecified values: the fragment kernel reads
-// them). One level of detail per quad, as GPUs compute it from the quad's derivatives. The
-// lanes are filtered together by the texture kernel, or one by one when only a few are asked
-// for (the kernel's cost does not depend on how many lanes are used). `colour_only`: the caller
-// reads only the colour channels (emissive), so lookups that read only texels of zero colour are
-// skipped whatever their alpha; otherwise only those whose texels are all zero.
-void sampleQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
-                    uint32_t lanes, bool colour_only, float rgba[4][kTextureLanes]);
+// `ref`'s texture at a quad pair, the part that needs the pair's helper pixels: one level of
+// detail per quad, as GPUs compute it from the quad's derivatives, and the levels it selects
+// (sel[q] for lanes 4q..4q+3), and every lane's coordinates after the texture transform and mip
+// weight, ready for sampleLanes.
+struct QuadPairLookup {
+    LevelSelection sel[2];
+    TextureLanes lanes;
+};
+void prepareQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
+                     QuadPairLookup& out);
+
+// Whether two selections read the same levels the same way (their weights aside): lanes of both
+// can share one texture kernel call.
+bool sameLevels(const LevelSelection& a, const LevelSelection& b);
+
+// `ref`'s texture at the lanes set in `lane_mask`, each at (lanes.u, lanes.v) on the levels `sel`
+// selects with its own lanes.weight: linear RGBA per lane in lanes.rgba, the same bits as a
+// lookup of that one fragment. Every lane of lanes.rgba is written (those not asked for with
+// unspecified values: the fragment kernel reads them), and every lane's u, v and weight must be
+// initialised. The lanes are filtered together by the texture kernel, or one by one when only a
+// few are asked for (the kernel's cost does not depend on how many lanes are used).
+// `colour_only`: the caller reads only the colour channels (emissive), so lookups that read only
+// texels of zero colour are skipped whatever their alpha; otherwise only those whose texels are
+// all zero. `lane_mask` is not empty.
+void sampleLanes(const ShadeContext& ctx, const TextureRef& ref, const LevelSelection& sel,
+                 uint32_t lane_mask, bool colour_only, TextureLanes& lanes);
 
 // Whether fragments of `m` skip lighting (KHR_materials_unlit or --shading unlit).
 bool isUnlit(const ShadeContext& ctx, const Material& m);

@@ -26,10 +26,12 @@ struct TriangleRaster {
     Edge edges[3];
     const Primitive* prim;
     // The quad kernel's input: everything but the edge values and the viewport lanes is the
-    // triangle's, filled once; shadeQuadPair sets those two per quad pair.
+    // triangle's, filled once; queueQuadPair sets those two per quad pair.
     QuadInput quad;
     // Pixel index of lane l relative to the quad pair's first pixel (the tile's, laneOffsets).
     const size_t* lane_offset;
+    // The lookups the material makes: base colour (0) and emissive (1; not when its factor is 0).
+    bool textured[2];
     // The vertex attributes and material constants the lanes share, filled when the first
     // lanes of the triangle pass the depth test (many small triangles never get there).
     bool frag_ready;
@@ -66,12 +68,12 @@ void fillFragmentTriangle(const ShadeContext& shade, TriangleRaster& tr) {
     tr.frag_ready = true;
 }
 
-// Lit, non-BLEND lanes of a tile's quad pairs waiting for the lighting kernel, which shades two
+// Lit, non-BLEND lanes of a tile's fragments waiting for the lighting kernel, which shades two
 // blocks of eight lanes in one call for about 1.4 times the cost of one block (its chains
-// interleave, light_kernel.h). The blocks fill in queue order: a pair with at most
-// kQueuedLanes lit lanes is packed lane by lane (triangles that leave one or two lanes per pair,
-// dense: 1.9 on average), a pair with more is written by the fragment kernel straight into the
-// next whole block, its lanes in place. The kernel's lanes are independent, so neither changes
+// interleave, light_kernel.h). The blocks fill in queue order: the lanes of a fragment kernel
+// call (shadeLanes) with at most kQueuedLanes lit lanes are packed lane by lane (a triangle's
+// last few lanes), those of a call with more are written by the fragment kernel straight into
+// the next whole block, its lanes in place. The kernel's lanes are independent, so neither changes
 // a bit. A queued lane goes to the sink when it is queued (`queue`: the frame's depth, which
 // the next triangle's depth test must see; a fragment list's node and key, in primitive order),
 // its colour when the batch is shaded (`writeQueued`), in queue order, so a pixel queued twice
@@ -81,7 +83,7 @@ void fillFragmentTriangle(const ShadeContext& shade, TriangleRaster& tr) {
 // these two halves when its queuesLight() says so: the frame and the fragment lists always, the
 // layers when each fragment goes to one layer (copies into several layers need the colour).
 
-// Pairs with at most this many lit lanes are packed into the queue lane by lane.
+// Calls with at most this many lit lanes are packed into the light queue lane by lane.
 constexpr uint32_t kQueuedLanes = 4;
 
 struct LightBatch {
@@ -123,13 +125,161 @@ void useMaterial(const RasterContext& ctx, LightBatch& batch, const LightMateria
     batch.material = material;
 }
 
-// Two 2x2 quads at (qx, qy) and (qx + 2, qy) (qx a multiple of 4, qy even): the quad kernel finds
-// coverage, barycentrics and depth for the 8 pixels at once; the covered ones are then shaded and
-// handed to the sink one by one, in lane order.
+// Lanes of the current triangle that passed the depth test, waiting for the texture, fragment
+// and lighting kernels. A triangle's quad pairs leave a few lanes each (on average demo 5.2 of 8,
+// ToyCar 2.8, dense 1.9: the edges of small triangles), and those kernels cost the same for one
+// lane as for eight, so the lanes are packed here, in pair and lane order, and shaded eight at
+// a time; the kernels' lanes are independent, so this changes no bit. The lanes are distinct
+// pixels of one triangle, so shading them later in the triangle changes no depth test. The
+// queue is shaded when full, before a quad whose lookups read other levels (one texture kernel
+// call reads one selection) and at the end of the triangle, before the next one is tested.
+struct FragmentQueue {
+    int count = 0;
+    // Zeroed once: the kernels read every lane (the lanes past `count` keep earlier values).
+    alignas(32) float persp[3][kQuadLanes] = {};
+    alignas(32) float z[kQuadLanes] = {};
+    alignas(32) float distance[kQuadLanes] = {};
+    size_t pixel[kQuadLanes] = {};
+    // The base colour (0) and emissive (1) lookups: each lane's coordinates and mip weight, the
+    // levels every queued lane reads, and the texels once sampled.
+    TextureLanes texture[2] = {};
+    LevelSelection sel[2];
+};
+
+// Lanes ready for the texture, fragment and lighting kernels: the queue's, or a quad pair's in
+// place (lane arrays of kQuadLanes; texture[k] and sel[k] read only for the material's lookups).
+struct FragmentLanes {
+    const float (*persp)[kQuadLanes];
+    const float* z;
+    const float* distance;
+    const size_t* pixel;
+    TextureLanes* texture[2];
+    const LevelSelection* sel[2];
+};
+
+// Shades the lanes set in `lanes`: their texels (the texture kernel), attributes, base colour and
+// alpha test (the fragment kernel), then the lanes that pass are lit together (the lighting
+// kernel) and handed to the sink, in lane order.
 template <class Sink>
-void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int32_t qy, Sink& sink,
-                   LightBatch& batch, TileCounters& counters) {
+void shadeLanes(const RasterContext& ctx, TriangleRaster& tr, const FragmentLanes& f,
+                uint32_t lanes, Sink& sink, LightBatch& batch, TileCounters& counters) {
     const SetupTri& t = *tr.tri;
+    const Material& m = *tr.material;
+    const TextureRef* refs[2] = {&m.base_color_texture, &m.emissive_texture};
+    for (int k = 0; k < 2; ++k)
+        if (tr.textured[k]) // the fragment kernel reads the emissive colour, not its alpha
+            sampleLanes(ctx.shade, *refs[k], *f.sel[k], lanes, k == 1, *f.texture[k]);
+    const float(*base_texel)[kQuadLanes] = tr.textured[0] ? f.texture[0]->rgba : nullptr;
+    const float(*emissive_texel)[kQuadLanes] = tr.textured[1] ? f.texture[1]->rgba : nullptr;
+
+    if (!tr.frag_ready)
+        fillFragmentTriangle(ctx.shade, tr);
+    const bool unlit = isUnlit(ctx.shade, m);
+    const bool blend = m.alpha_mode == AlphaMode::Blend;
+    const bool queued = !unlit && !blend && sink.queuesLight();
+    if (queued && laneCount(lanes) > kQueuedLanes) {
+        // A whole block of the light queue, written in place by the fragment kernel.
+        useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
+        int start = (batch.count + kLightLanes - 1) / kLightLanes * kLightLanes;
+        if (start == LightBatch::kLanes) {
+            shadeBatch(ctx, batch, sink);
+            start = 0;
+        }
+        const uint32_t passed =
+            ctx.fragment_kernel(tr.frag, f.persp, base_texel, emissive_texel, lanes,
+                                batch.blockOf(start), batch.alpha + start);
+        if (passed == 0)
+            return;
+        counters.passed += laneCount(passed);
+        for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
+            const int l = std::countr_zero(rest);
+            batch.handle[start + l] = sink.queue(f.pixel[l], f.z[l], t.primitive_id);
+        }
+        batch.queued |= passed << start;
+        batch.count = start + kLightLanes;
+        if (batch.count == LightBatch::kLanes)
+            shadeBatch(ctx, batch, sink);
+        return;
+    }
+    LightLanes light;
+    alignas(32) float alpha[kQuadLanes];
+    const uint32_t passed =
+        ctx.fragment_kernel(tr.frag, f.persp, base_texel, emissive_texel, lanes, light, alpha);
+    if (passed == 0)
+        return;
+    counters.passed += laneCount(passed);
+    if (queued) {
+        // At most kQueuedLanes lanes: packed into the light queue.
+        useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
+        for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
+            const int l = std::countr_zero(rest);
+            const int i = batch.count++, j = i % kLightLanes;
+            batch.handle[i] = sink.queue(f.pixel[l], f.z[l], t.primitive_id);
+            LightLanes& b = batch.blockOf(i);
+            for (int c = 0; c < 3; ++c) {
+                b.albedo[c][j] = light.albedo[c][l];
+                b.emissive[c][j] = light.emissive[c][l];
+                b.world[c][j] = light.world[c][l];
+                b.normal[c][j] = light.normal[c][l];
+            }
+            batch.alpha[i] = alpha[l];
+            batch.queued |= 1u << i;
+            if (batch.count == LightBatch::kLanes)
+                shadeBatch(ctx, batch, sink);
+        }
+        return;
+    }
+    shadeBatch(ctx, batch, sink); // queued colours land before these
+    if (!unlit) {
+        const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
+        ctx.shade.light_kernel(ctx.shade.lights, ctx.shade.light_count,
+                               {m.metallic_factor, m.roughness_factor}, eye, &light, 1,
+                               int(std::bit_width(passed)));
+    }
+    for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
+        const int l = std::countr_zero(rest);
+        Fragment frag;
+        frag.z = f.z[l];
+        frag.distance = f.distance[l];
+        frag.blend = blend;
+        frag.color.a = alpha[l];
+        frag.primitive_id = t.primitive_id;
+        for (int c = 0; c < 3; ++c)
+            frag.color[c] = unlit ? light.albedo[c][l] + light.emissive[c][l] : light.rgb[c][l];
+        if (sink.wants_gbuffer) {
+            const glm::vec3 base(light.albedo[0][l], light.albedo[1][l], light.albedo[2][l]);
+            const glm::vec3 emissive(light.emissive[0][l], light.emissive[1][l],
+                                     light.emissive[2][l]);
+            const glm::vec3 normal(light.normal[0][l], light.normal[1][l], light.normal[2][l]);
+            frag.g = surfaceSample(ctx.shade, m, base, emissive, normal);
+        }
+        sink.write(f.pixel[l], frag);
+    }
+}
+
+// Shades the queued lanes and empties the queue.
+template <class Sink>
+void shadeQueue(const RasterContext& ctx, TriangleRaster& tr, FragmentQueue& queue, Sink& sink,
+                LightBatch& batch, TileCounters& counters) {
+    if (queue.count == 0)
+        return;
+    const uint32_t lanes = (1u << queue.count) - 1;
+    queue.count = 0;
+    const FragmentLanes f{queue.persp,
+                          queue.z,
+                          queue.distance,
+                          queue.pixel,
+                          {&queue.texture[0], &queue.texture[1]},
+                          {&queue.sel[0], &queue.sel[1]}};
+    shadeLanes(ctx, tr, f, lanes, sink, batch, counters);
+}
+
+// Two 2x2 quads at (qx, qy) and (qx + 2, qy) (qx a multiple of 4, qy even): the quad kernel finds
+// coverage, barycentrics and depth for the 8 pixels at once; the covered ones that pass the
+// depth test join the fragment queue, with what their texture lookups need from the pair.
+template <class Sink>
+void queueQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int32_t qy, Sink& sink,
+                   FragmentQueue& queue, LightBatch& batch, TileCounters& counters) {
     QuadInput& in = tr.quad;
     for (int k = 0; k < 3; ++k)
         in.edge[k] = double(tr.edges[k].at(pixelCentre(qx), pixelCentre(qy)));
@@ -173,126 +323,77 @@ void shadeQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         }
     }
 
-    const bool textured = m.base_color_texture.image >= 0 || m.emissive_texture.image >= 0;
-    QuadPairUv pair_uv; // read only when textured, then written in full
-    if (textured) {
+    QuadPairLookup lookup[2]; // read only where the material makes the lookup
+    if (tr.textured[0] || tr.textured[1]) {
         // Every lane is interpolated (helper pixels included) so each quad has coarse
         // derivatives, one pair per quad (as GPUs' ddx/ddy): sum_k persp_k uv_k, perspective-
         // correct, summed in vertex order.
         const glm::vec2 uv0 = tr.v[0]->uv, uv1 = tr.v[1]->uv, uv2 = tr.v[2]->uv;
+        QuadPairUv pair_uv;
         for (int l = 0; l < kQuadLanes; ++l) {
             pair_uv.u[l] = q.persp[0][l] * uv0.x + q.persp[1][l] * uv1.x + q.persp[2][l] * uv2.x;
             pair_uv.v[l] = q.persp[0][l] * uv0.y + q.persp[1][l] * uv1.y + q.persp[2][l] * uv2.y;
         }
+        const TextureRef* refs[2] = {&m.base_color_texture, &m.emissive_texture};
+        for (int k = 0; k < 2; ++k)
+            if (tr.textured[k])
+                prepareQuadPair(ctx.shade, *refs[k], pair_uv, lookup[k]);
     }
-
-    // The textures at the lanes that passed, together (the texture kernel).
-    const bool base_textured = m.base_color_texture.image >= 0;
-    const bool emissive_textured =
-        m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
-    // sampleQuadPair writes every lane (the fragment kernel reads every lane of the texels it
-    // is given, fragment_kernel.h); the arrays are read only when sampled.
-    alignas(32) float base_texel[4][kTextureLanes], emissive_texel[4][kTextureLanes];
-    if (base_textured)
-        sampleQuadPair(ctx.shade, m.base_color_texture, pair_uv, tested, false, base_texel);
-    if (emissive_textured) // the fragment kernel reads the emissive colour, not its alpha
-        sampleQuadPair(ctx.shade, m.emissive_texture, pair_uv, tested, true, emissive_texel);
-
-    // Every lane's attributes, base colour and alpha test (the fragment kernel), then the
-    // lanes that pass are shaded together (the lighting kernel) and handed to the sink.
-    if (!tr.frag_ready)
-        fillFragmentTriangle(ctx.shade, tr);
-    const bool unlit = isUnlit(ctx.shade, m);
-    const bool blend = m.alpha_mode == AlphaMode::Blend;
-    const bool queued = !unlit && !blend && sink.queuesLight();
-    if (queued && laneCount(tested) > kQueuedLanes) {
-        // A whole block of the queue, written in place by the fragment kernel.
-        useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
-        int start = (batch.count + kLightLanes - 1) / kLightLanes * kLightLanes;
-        if (start == LightBatch::kLanes) {
-            shadeBatch(ctx, batch, sink);
-            start = 0;
-        }
-        const uint32_t passed =
-            ctx.fragment_kernel(tr.frag, q.persp, base_textured ? base_texel : nullptr,
-                                emissive_textured ? emissive_texel : nullptr, tested,
-                                batch.blockOf(start), batch.alpha + start);
-        if (passed == 0)
-            return;
-        counters.passed += laneCount(passed);
-        for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
-            const int l = std::countr_zero(rest);
-            batch.handle[start + l] =
-                sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
-        }
-        batch.queued |= passed << start;
-        batch.count = start + kLightLanes;
-        if (batch.count == LightBatch::kLanes)
-            shadeBatch(ctx, batch, sink);
+    // A full pair whose quads read the same levels is shaded where it is, without the copies
+    // into the queue (after the queue's lanes, which come before it). Measured against pairs of
+    // six or more lanes in place, and none: demo 1.026x / 1.009x / 0.976x, ToyCar 1.069x /
+    // 1.064x / 1.084x the time before the queue.
+    if (tested == 0xffu && (!tr.textured[0] || sameLevels(lookup[0].sel[0], lookup[0].sel[1])) &&
+        (!tr.textured[1] || sameLevels(lookup[1].sel[0], lookup[1].sel[1]))) {
+        shadeQueue(ctx, tr, queue, sink, batch, counters);
+        size_t pixel[kQuadLanes];
+        for (int l = 0; l < kQuadLanes; ++l)
+            pixel[l] = first_pixel + tr.lane_offset[l];
+        const FragmentLanes f{q.persp,
+                              q.z,
+                              q.distance,
+                              pixel,
+                              {&lookup[0].lanes, &lookup[1].lanes},
+                              {&lookup[0].sel[0], &lookup[1].sel[0]}};
+        shadeLanes(ctx, tr, f, tested, sink, batch, counters);
         return;
     }
-    LightLanes light;
-    alignas(32) float alpha[kQuadLanes];
-    const uint32_t passed =
-        ctx.fragment_kernel(tr.frag, q.persp, base_textured ? base_texel : nullptr,
-                            emissive_textured ? emissive_texel : nullptr, tested, light, alpha);
-    if (passed == 0)
-        return;
-    counters.passed += laneCount(passed);
-    if (queued) {
-        // At most kQueuedLanes lanes: packed into the queue.
-        useMaterial(ctx, batch, {m.metallic_factor, m.roughness_factor}, sink);
-        for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
-            const int l = std::countr_zero(rest);
-            const int i = batch.count++, j = i % kLightLanes;
-            batch.handle[i] = sink.queue(first_pixel + tr.lane_offset[l], q.z[l], t.primitive_id);
-            LightLanes& b = batch.blockOf(i);
-            for (int c = 0; c < 3; ++c) {
-                b.albedo[c][j] = light.albedo[c][l];
-                b.emissive[c][j] = light.emissive[c][l];
-                b.world[c][j] = light.world[c][l];
-                b.normal[c][j] = light.normal[c][l];
-            }
-            batch.alpha[i] = alpha[l];
-            batch.queued |= 1u << i;
-            if (batch.count == LightBatch::kLanes)
-                shadeBatch(ctx, batch, sink);
+    for (int quad = 0; quad < 2; ++quad) {
+        uint32_t rest = (tested >> (4 * quad)) & 0xfu;
+        if (rest == 0)
+            continue;
+        bool same = true;
+        for (int k = 0; k < 2; ++k)
+            same = same && (!tr.textured[k] || sameLevels(lookup[k].sel[quad], queue.sel[k]));
+        if (!same)
+            shadeQueue(ctx, tr, queue, sink, batch, counters);
+        for (int k = 0; k < 2; ++k)
+            if (tr.textured[k])
+                queue.sel[k] = lookup[k].sel[quad];
+        for (; rest != 0; rest &= rest - 1) {
+            const int l = 4 * quad + std::countr_zero(rest), i = queue.count++;
+            queue.pixel[i] = first_pixel + tr.lane_offset[l];
+            queue.z[i] = q.z[l];
+            queue.distance[i] = q.distance[l];
+            for (int k = 0; k < 3; ++k)
+                queue.persp[k][i] = q.persp[k][l];
+            for (int k = 0; k < 2; ++k)
+                if (tr.textured[k]) {
+                    queue.texture[k].u[i] = lookup[k].lanes.u[l];
+                    queue.texture[k].v[i] = lookup[k].lanes.v[l];
+                    queue.texture[k].weight[i] = lookup[k].lanes.weight[l];
+                }
+            if (queue.count == kQuadLanes)
+                shadeQueue(ctx, tr, queue, sink, batch, counters);
         }
-        return;
-    }
-    shadeBatch(ctx, batch, sink); // queued colours land before these
-    if (!unlit) {
-        const float eye[3] = {ctx.shade.eye.x, ctx.shade.eye.y, ctx.shade.eye.z};
-        ctx.shade.light_kernel(ctx.shade.lights, ctx.shade.light_count,
-                               {m.metallic_factor, m.roughness_factor}, eye, &light, 1,
-                               int(std::bit_width(passed)));
-    }
-    for (uint32_t rest = passed; rest != 0; rest &= rest - 1) {
-        const int l = std::countr_zero(rest);
-        Fragment frag;
-        frag.z = q.z[l];
-        frag.distance = q.distance[l];
-        frag.blend = blend;
-        frag.color.a = alpha[l];
-        frag.primitive_id = t.primitive_id;
-        for (int c = 0; c < 3; ++c)
-            frag.color[c] = unlit ? light.albedo[c][l] + light.emissive[c][l] : light.rgb[c][l];
-        if (sink.wants_gbuffer) {
-            const glm::vec3 base(light.albedo[0][l], light.albedo[1][l], light.albedo[2][l]);
-            const glm::vec3 emissive(light.emissive[0][l], light.emissive[1][l],
-                                     light.emissive[2][l]);
-            const glm::vec3 normal(light.normal[0][l], light.normal[1][l], light.normal[2][l]);
-            frag.g = surfaceSample(ctx.shade, m, base, emissive, normal);
-        }
-        sink.write(first_pixel + tr.lane_offset[l], frag);
     }
 }
 
 template <class Sink>
 void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, const SetupTri& t,
                        int32_t tile_x0, int32_t tile_y0, int32_t tile_x1, int32_t tile_y1,
-                       const size_t* lane_offset, Sink& sink, LightBatch& batch,
-                       TileCounters& counters) {
+                       const size_t* lane_offset, Sink& sink, FragmentQueue& queue,
+                       LightBatch& batch, TileCounters& counters) {
     const GeometryState& geo = *ctx.geometry;
     const Draw& draw = geo.draws[t.draw];
     const Primitive& prim = ctx.shade.scene->meshes[draw.mesh].primitives[draw.primitive];
@@ -314,6 +415,9 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     tr.lane_offset = lane_offset;
     tr.prim = &prim;
     tr.frag_ready = false;
+    const Material& m = *tr.material;
+    tr.textured[0] = m.base_color_texture.image >= 0;
+    tr.textured[1] = m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
     sink.beginTriangle(t, tr.material->alpha_mode == AlphaMode::Blend);
 
     // Pixel range of this triangle in this tile, widened to whole quad pairs.
@@ -328,9 +432,10 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
                 continue;
             for (int32_t qy = by; qy <= by1; qy += 2)
                 for (int32_t qx = bx; qx <= bx1; qx += 4)
-                    shadeQuadPair(ctx, tr, qx, qy, sink, batch, counters);
+                    queueQuadPair(ctx, tr, qx, qy, sink, queue, batch, counters);
         }
     }
+    shadeQueue(ctx, tr, queue, sink, batch, counters);
 }
 
 template <class Sink>
@@ -353,6 +458,7 @@ void rasterizeTileImpl(const RasterContext& ctx, uint32_t tile, Sink& sink,
     // Counted on the stack and added once: neighbouring tiles' counters share cache lines, and
     // the workers usually raster neighbouring tiles (false sharing on every fragment).
     TileCounters local;
+    FragmentQueue queue;
     LightBatch batch;
     // Pixel index of lane l relative to a quad pair's first pixel (lane = quad*4 + dy*2 + dx).
     size_t lane_offset[kQuadLanes];
@@ -377,8 +483,8 @@ void rasterizeTileImpl(const RasterContext& ctx, uint32_t tile, Sink& sink,
                 const SetupTri& t = chunk.tris[bins.items[i]];
                 if (ctx.blend_last && isBlend(t) != (pass == 1))
                     continue;
-                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, lane_offset, sink, batch,
-                                  local);
+                rasterizeTriangle(ctx, chunk, t, tx0, ty0, tx1, ty1, lane_offset, sink, queue,
+                                  batch, local);
             }
         }
     shadeBatch(ctx, batch, sink);

@@ -3,8 +3,11 @@
 
 #include <raster/texture.h>
 
+#include <glm/geometric.hpp>
+#include <glm/gtc/type_precision.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -175,7 +178,7 @@ TEST(Texture, MipChainMarksBlocksOfZeroTexels) {
     EXPECT_FALSE(raster::zeroTexels(bare, 0, 7, 0, 7, false));
 }
 
-// Lookups that read only zero texels are skipped (sampleQuadPair): the frame must be the one
+// Lookups that read only zero texels are skipped (sampleLanes): the frame must be the one
 // sampled in full, texel for texel. A sparse image (most texels zero in every channel, a few
 // with colour, many with alpha only in one quarter) as base colour and emissive texture of opaque
 // and blended quads seen minified, near 1:1 and magnified, with coordinates beyond [0, 1] (repeat),
@@ -247,6 +250,132 @@ TEST(Texture, LookupsOfZeroTexelsAreSkippedWithTheSameBits) {
                           std::bit_cast<uint32_t>(sampled.color[i]);
             EXPECT_EQ(differ, 0u) << "filter " << int(f) << " simd " << simd;
         }
+}
+
+// Each 2x2 quad selects its mip level from its own derivatives, and the tile raster packs the
+// lanes of a triangle's quads for the texture kernel (tile_raster.cpp, FragmentQueue), so a lane
+// must be filtered on its own quad's levels even when the quads before it in the queue read
+// others. A plane tilted away from the eye, cut into small triangles (whose ends empty the
+// queue), with an image whose every level is one colour and nearest mip filtering: every pixel
+// shows the level its quad's derivatives select, computed here from the plane's analytic
+// texture coordinates (quads within 0.01 of a level boundary are not judged).
+TEST(Texture, EachQuadReadsTheLevelOfItsOwnDerivatives) {
+    constexpr uint32_t kTexels = 256, kW = 96, kH = 160;
+    Image img = makeImage(kTexels, kTexels, false, [](uint32_t, uint32_t) { return 255; });
+    auto levelColour = [](size_t k) {
+        return glm::u8vec4(uint8_t(20 + 25 * k), uint8_t(235 - 20 * k), uint8_t(k % 2 ? 200 : 40),
+                           255);
+    };
+    for (size_t k = 0; k < img.levels.size(); ++k) {
+        raster::MipLevel& level = img.levels[k];
+        const glm::u8vec4 c = levelColour(k);
+        for (size_t t = 0; t < size_t(level.width) * level.height; ++t)
+            for (int ch = 0; ch < 4; ++ch) {
+                level.rgba8[4 * t + size_t(ch)] = c[ch];
+                if (!level.linear.empty())
+                    level.linear[4 * t + size_t(ch)] = float(int32_t(c[ch])) * (1.0f / 255.0f);
+            }
+    }
+    img.zero_colour_blocks = img.zero_blocks = false;
+    const float max_level = float(img.levels.size() - 1);
+
+    Sampler nearest;
+    nearest.mag = nearest.min = Filter::Nearest;
+    nearest.mip = MipFilter::Nearest;
+    raster::Material m = flatMaterial({1, 1, 1, 1});
+    m.base_color_texture.image = 0;
+    m.base_color_texture.sampler = 0;
+    // The plane P(a, b) = (x0 + a lx, y0 + b ly, -(d0 + a kx + b lz)), a, b in [0, 1], with uv =
+    // (su a, sv b), over the whole view, turned so the level changes along rows and columns,
+    // cut into a grid of cells, two triangles each: small (1 to 10 pixels) or large ones.
+    constexpr double x0 = -400.0, lx = 800.0, y0 = -150.0, ly = 750.0, d0 = 50.0, lz = 400.0;
+    constexpr double kx = 300.0;
+    constexpr double su = 8.0, sv = 24.0;
+    auto planeScene = [&](uint32_t cells_a, uint32_t cells_b) {
+        raster::Scene s;
+        s.images.push_back(img);
+        s.samplers.push_back(nearest);
+        const int32_t mat = addMaterial(s, m);
+        std::vector<glm::vec3> positions;
+        std::vector<glm::vec2> uvs;
+        std::vector<uint32_t> indices;
+        for (uint32_t j = 0; j <= cells_b; ++j)
+            for (uint32_t i = 0; i <= cells_a; ++i) {
+                const double a = double(i) / cells_a, b = double(j) / cells_b;
+                positions.emplace_back(float(x0 + a * lx), float(y0 + b * ly),
+                                       float(-(d0 + a * kx + b * lz)));
+                uvs.emplace_back(float(su * a), float(sv * b));
+            }
+        for (uint32_t j = 0; j < cells_b; ++j)
+            for (uint32_t i = 0; i < cells_a; ++i) {
+                const uint32_t v = j * (cells_a + 1) + i, up = v + cells_a + 1;
+                indices.insert(indices.end(), {v, v + 1, up + 1, v, up + 1, up});
+            }
+        addMesh(s, positions, indices, mat).texcoords0 = uvs;
+        return s;
+    };
+    raster::View view = pixelView(kW, kH, 64.0f);
+    view.zfar = 1000.0f;
+
+    // Where the eye ray through pixel centre (x + 1/2, y + 1/2), direction (x + 1/2 - W/2,
+    // H/2 - y - 1/2, -64), meets the plane: (a, b) and the distance along the view axis.
+    struct Hit {
+        double a, b, depth;
+    };
+    auto hitAt = [&](double x, double y) {
+        const double dx = x + 0.5 - kW / 2.0, dy = kH / 2.0 - y - 0.5, dz = 64.0;
+        // lambda dx = x0 + a lx, lambda dy = y0 + b ly and lambda dz = d0 + a kx + b lz.
+        const double lambda =
+            (d0 - kx * x0 / lx - lz * y0 / ly) / (dz - kx * dx / lx - lz * dy / ly);
+        return Hit{(lambda * dx - x0) / lx, (lambda * dy - y0) / ly, lambda * dz};
+    };
+    auto onPlane = [&](const Hit& h) {
+        return h.a > 0.001 && h.a < 0.999 && h.b > 0.001 && h.b < 0.999 && h.depth < 990.0;
+    };
+    // The texture coordinates there, in texels.
+    auto texelAt = [&](double x, double y) {
+        const Hit h = hitAt(x, y);
+        return glm::dvec2(su * h.a * kTexels, sv * h.b * kTexels);
+    };
+    int judged = 0, levels_seen = 0;
+    uint32_t seen = 0;
+    for (const uint32_t cells : {100u, 4u})
+        for (const bool simd : {true, false}) {
+            raster::RenderOptions o;
+            o.simd = simd;
+            const raster::Frame f = render(planeScene(cells, cells * 6 / 5), view, o);
+            for (uint32_t qy = 0; qy + 1 < kH; qy += 2)
+                for (uint32_t qx = 0; qx + 1 < kW; qx += 2) {
+                    const glm::dvec2 t0 = texelAt(qx, qy);
+                    const glm::dvec2 ddx = texelAt(qx + 1, qy) - t0, ddy = texelAt(qx, qy + 1) - t0;
+                    const double rho2 = std::max(glm::dot(ddx, ddx), glm::dot(ddy, ddy));
+                    const double lod =
+                        rho2 > 1.0 ? std::min(0.5 * std::log2(rho2), double(max_level)) : 0.0;
+                    const double frac = lod - std::floor(lod);
+                    if (rho2 > 1.0 && (std::fabs(frac - 0.5) < 0.01 || lod < 0.01))
+                        continue;
+                    const size_t k = size_t(std::floor(lod + 0.5));
+                    const glm::u8vec4 c = levelColour(k);
+                    const glm::vec4 want(float(int32_t(c.r)) / 255.0f, float(int32_t(c.g)) / 255.0f,
+                                         float(int32_t(c.b)) / 255.0f, 1.0f);
+                    for (uint32_t y = qy; y < qy + 2; ++y)
+                        for (uint32_t x = qx; x < qx + 2; ++x) {
+                            if (!onPlane(hitAt(x, y)))
+                                continue;
+                            const glm::vec4 got = pixel(f, x, y);
+                            EXPECT_NEAR(got.r, want.r, 1e-6f)
+                                << "pixel " << x << "," << y << " lod " << lod << " simd " << simd
+                                << " cells " << cells;
+                            EXPECT_NEAR(got.g, want.g, 1e-6f) << "pixel " << x << "," << y;
+                            ++judged;
+                            seen |= 1u << k;
+                        }
+                }
+        }
+    levels_seen = std::popcount(seen);
+    EXPECT_GT(judged, 2 * 10000) << levels_seen;
+    std::printf("judged %d levels %d\n", judged, levels_seen);
+    EXPECT_GE(levels_seen, 4); // the plane spans several levels
 }
 
 } // namespace
