@@ -106,6 +106,14 @@ void prepareQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadP
     }
 }
 
+bool sameFootprint(const Scene& scene, const TextureRef& a, const TextureRef& b) {
+    const Image& ia = scene.images[size_t(a.image)];
+    const Image& ib = scene.images[size_t(b.image)];
+    return a.texcoord == b.texcoord && a.sampler == b.sampler && a.transform == b.transform &&
+           ia.levels.size() == ib.levels.size() && ia.levels[0].width == ib.levels[0].width &&
+           ia.levels[0].height == ib.levels[0].height;
+}
+
 bool sameLevels(const LevelSelection& a, const LevelSelection& b) {
     return a.level0 == b.level0 && a.level1 == b.level1 && a.filter == b.filter &&
            a.mix_levels == b.mix_levels;

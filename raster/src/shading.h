@@ -49,6 +49,11 @@ struct QuadPairLookup {
 void prepareQuadPair(const ShadeContext& ctx, const TextureRef& ref, const QuadPairUv& uv,
                      QuadPairLookup& out);
 
+// Whether lookups of `a` and `b` at the same fragments read the same coordinates and select the
+// same levels: the same texture coordinates, transform and sampler, and images of the same size
+// and number of levels (what prepareQuadPair depends on besides the pair's coordinates).
+bool sameFootprint(const Scene& scene, const TextureRef& a, const TextureRef& b);
+
 // Whether two selections read the same levels the same way (their weights aside): lanes of both
 // can share one texture kernel call.
 bool sameLevels(const LevelSelection& a, const LevelSelection& b);

@@ -32,6 +32,9 @@ struct TriangleRaster {
     const size_t* lane_offset;
     // The lookups the material makes: base colour (0) and emissive (1; not when its factor is 0).
     bool textured[2];
+    // Both are made and the emissive one reads the base colour's coordinates and levels
+    // (sameFootprint): its quad pairs are prepared once, the coordinates queued once.
+    bool shared_lookup;
     // The vertex attributes and material constants the lanes share, filled when the first
     // lanes of the triangle pass the depth test (many small triangles never get there).
     bool frag_ready;
@@ -166,6 +169,12 @@ void shadeLanes(const RasterContext& ctx, TriangleRaster& tr, const FragmentLane
     const SetupTri& t = *tr.tri;
     const Material& m = *tr.material;
     const TextureRef* refs[2] = {&m.base_color_texture, &m.emissive_texture};
+    if (tr.shared_lookup) {
+        TextureLanes& emissive = *f.texture[1];
+        std::copy_n(f.texture[0]->u, kTextureLanes, emissive.u);
+        std::copy_n(f.texture[0]->v, kTextureLanes, emissive.v);
+        std::copy_n(f.texture[0]->weight, kTextureLanes, emissive.weight);
+    }
     for (int k = 0; k < 2; ++k)
         if (tr.textured[k]) // the fragment kernel reads the emissive colour, not its alpha
             sampleLanes(ctx.shade, *refs[k], *f.sel[k], lanes, k == 1, *f.texture[k]);
@@ -324,6 +333,8 @@ void queueQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
     }
 
     QuadPairLookup lookup[2]; // read only where the material makes the lookup
+    // The lookups' levels and coordinates: the emissive one's are the base colour's when shared.
+    const QuadPairLookup* look[2] = {&lookup[0], tr.shared_lookup ? &lookup[0] : &lookup[1]};
     if (tr.textured[0] || tr.textured[1]) {
         // Every lane is interpolated (helper pixels included) so each quad has coarse
         // derivatives, one pair per quad (as GPUs' ddx/ddy): sum_k persp_k uv_k, perspective-
@@ -336,15 +347,15 @@ void queueQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
         }
         const TextureRef* refs[2] = {&m.base_color_texture, &m.emissive_texture};
         for (int k = 0; k < 2; ++k)
-            if (tr.textured[k])
+            if (tr.textured[k] && !(k == 1 && tr.shared_lookup))
                 prepareQuadPair(ctx.shade, *refs[k], pair_uv, lookup[k]);
     }
     // A full pair whose quads read the same levels is shaded where it is, without the copies
     // into the queue (after the queue's lanes, which come before it). Measured against pairs of
     // six or more lanes in place, and none: demo 1.026x / 1.009x / 0.976x, ToyCar 1.069x /
     // 1.064x / 1.084x the time before the queue.
-    if (tested == 0xffu && (!tr.textured[0] || sameLevels(lookup[0].sel[0], lookup[0].sel[1])) &&
-        (!tr.textured[1] || sameLevels(lookup[1].sel[0], lookup[1].sel[1]))) {
+    if (tested == 0xffu && (!tr.textured[0] || sameLevels(look[0]->sel[0], look[0]->sel[1])) &&
+        (!tr.textured[1] || sameLevels(look[1]->sel[0], look[1]->sel[1]))) {
         shadeQueue(ctx, tr, queue, sink, batch, counters);
         size_t pixel[kQuadLanes];
         for (int l = 0; l < kQuadLanes; ++l)
@@ -354,7 +365,7 @@ void queueQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
                               q.distance,
                               pixel,
                               {&lookup[0].lanes, &lookup[1].lanes},
-                              {&lookup[0].sel[0], &lookup[1].sel[0]}};
+                              {&look[0]->sel[0], &look[1]->sel[0]}};
         shadeLanes(ctx, tr, f, tested, sink, batch, counters);
         return;
     }
@@ -364,12 +375,12 @@ void queueQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
             continue;
         bool same = true;
         for (int k = 0; k < 2; ++k)
-            same = same && (!tr.textured[k] || sameLevels(lookup[k].sel[quad], queue.sel[k]));
+            same = same && (!tr.textured[k] || sameLevels(look[k]->sel[quad], queue.sel[k]));
         if (!same)
             shadeQueue(ctx, tr, queue, sink, batch, counters);
         for (int k = 0; k < 2; ++k)
             if (tr.textured[k])
-                queue.sel[k] = lookup[k].sel[quad];
+                queue.sel[k] = look[k]->sel[quad];
         for (; rest != 0; rest &= rest - 1) {
             const int l = 4 * quad + std::countr_zero(rest), i = queue.count++;
             queue.pixel[i] = first_pixel + tr.lane_offset[l];
@@ -378,7 +389,7 @@ void queueQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
             for (int k = 0; k < 3; ++k)
                 queue.persp[k][i] = q.persp[k][l];
             for (int k = 0; k < 2; ++k)
-                if (tr.textured[k]) {
+                if (tr.textured[k] && !(k == 1 && tr.shared_lookup)) {
                     queue.texture[k].u[i] = lookup[k].lanes.u[l];
                     queue.texture[k].v[i] = lookup[k].lanes.v[l];
                     queue.texture[k].weight[i] = lookup[k].lanes.weight[l];
@@ -418,6 +429,8 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     const Material& m = *tr.material;
     tr.textured[0] = m.base_color_texture.image >= 0;
     tr.textured[1] = m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
+    tr.shared_lookup = tr.textured[0] && tr.textured[1] &&
+                       sameFootprint(*ctx.shade.scene, m.base_color_texture, m.emissive_texture);
     sink.beginTriangle(t, tr.material->alpha_mode == AlphaMode::Blend);
 
     // Pixel range of this triangle in this tile, widened to whole quad pairs.

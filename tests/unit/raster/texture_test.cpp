@@ -378,5 +378,71 @@ TEST(Texture, EachQuadReadsTheLevelOfItsOwnDerivatives) {
     EXPECT_GE(levels_seen, 4); // the plane spans several levels
 }
 
+// The tile raster prepares the emissive lookup from the base colour's when both read the same
+// coordinates and levels (sameFootprint: texture coordinates, transform, sampler, image size and
+// levels): a frame with both textures must be, pixel by pixel, the sum of the frames with each
+// alone (unlit: base colour + emissive), whichever of those the two textures share.
+TEST(Texture, EmissiveReadsItsOwnCoordinatesAndLevels) {
+    const Image a =
+        makeImage(64, 64, true, [](uint32_t x, uint32_t y) { return (x * 7 + y * 3) % 256; });
+    const Image b =
+        makeImage(64, 64, true, [](uint32_t x, uint32_t y) { return (x * 5 + y * 11) % 256; });
+    const Image small =
+        makeImage(32, 64, true, [](uint32_t x, uint32_t y) { return (x * 9 + y) % 256; });
+    glm::mat3 scaled(1.0f);
+    scaled[0][0] = 2.0f;
+    scaled[2][1] = 0.25f;
+    struct Case {
+        const Image* emissive;
+        glm::mat3 transform;
+        int32_t sampler;
+    };
+    const Case cases[] = {{&b, glm::mat3(1.0f), 0},     // shared
+                          {&b, scaled, 0},              // another transform
+                          {&small, glm::mat3(1.0f), 0}, // another size
+                          {&b, glm::mat3(1.0f), 1}};    // another sampler
+    Sampler nearest_mips;
+    nearest_mips.mip = MipFilter::Nearest;
+    int checked = 0, lit = 0;
+    for (const Case& c : cases) {
+        auto frame = [&](bool base, bool emissive) {
+            raster::Scene s;
+            s.images = {a, *c.emissive};
+            s.samplers = {Sampler{}, nearest_mips};
+            raster::Material m = flatMaterial(base ? glm::vec4(1.0f) : glm::vec4(0, 0, 0, 1));
+            if (base) {
+                m.base_color_texture.image = 0;
+                m.base_color_texture.sampler = 0;
+            }
+            if (emissive) {
+                m.emissive_factor = glm::vec3(1.0f);
+                m.emissive_texture.image = 1;
+                m.emissive_texture.sampler = c.sampler;
+                m.emissive_texture.transform = c.transform;
+            }
+            // A quad turned away from the eye (several levels), in small and large triangles.
+            raster::Primitive& p = addMesh(
+                s, {{-60, -50, -70}, {60, -50, -70}, {60, 50, -200}, {-60, 50, -200}, {0, 0, -120}},
+                {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4}, addMaterial(s, m));
+            p.texcoords0 = {{0, 3}, {3, 3}, {3, 0}, {0, 0}, {1.5f, 1.2f}};
+            return render(s, pixelView(96, 80, 64.0f));
+        };
+        const raster::Frame both = frame(true, true), base = frame(true, false),
+                            emissive = frame(false, true);
+        for (uint32_t y = 0; y < 80; ++y)
+            for (uint32_t x = 0; x < 96; ++x) {
+                const glm::vec4 sum = pixel(base, x, y) + pixel(emissive, x, y);
+                const glm::vec4 got = pixel(both, x, y);
+                ASSERT_EQ(got.r, sum.r) << x << "," << y << " case " << checked / (96 * 80);
+                ASSERT_EQ(got.g, sum.g) << x << "," << y;
+                ASSERT_EQ(got.b, sum.b) << x << "," << y;
+                ++checked;
+                lit += pixel(base, x, y).r > 0.0f && pixel(emissive, x, y).r > 0.0f;
+            }
+    }
+    EXPECT_EQ(checked, 4 * 96 * 80);
+    EXPECT_GT(lit, 4 * 96 * 40); // both textures seen on most pixels
+}
+
 } // namespace
 } // namespace focal::test
