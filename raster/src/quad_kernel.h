@@ -26,11 +26,10 @@ struct QuadInput {
 };
 
 struct QuadOutput {
-    uint32_t mask;               // covered lanes
-    float lambda[3][kQuadLanes]; // screen-space barycentrics
-    float persp[3][kQuadLanes];  // perspective-correct barycentrics
-    float distance[kQuadLanes];  // view distance d = w
-    float z[kQuadLanes];         // stored depth D, clamped to [-1, 0]
+    uint32_t mask;              // covered lanes
+    float persp[3][kQuadLanes]; // perspective-correct barycentrics
+    float distance[kQuadLanes]; // view distance d = w
+    float z[kQuadLanes];        // stored depth D, clamped to [-1, 0]
 };
 
 using QuadKernel = void (*)(const QuadInput&, QuadOutput&);

@@ -34,9 +34,6 @@ void FOCAL_QUAD_KERNEL_NAME(const QuadInput& in, QuadOutput& out) {
         const float sum = q0 + q1 + q2;
         const float inv = sum != 0.0f ? 1.0f / sum : 0.0f;
         const float z = l0 * in.z[0] + l1 * in.z[1] + l2 * in.z[2];
-        out.lambda[0][l] = l0;
-        out.lambda[1][l] = l1;
-        out.lambda[2][l] = l2;
         out.persp[0][l] = q0 * inv;
         out.persp[1][l] = q1 * inv;
         out.persp[2][l] = q2 * inv;
