@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <new>
 #include <string>
 #include <utility>
@@ -278,12 +279,15 @@ Status Renderer::render(const Scene& scene, const View& view, const RenderOption
         // The background and the far depth, filled by the tile's owner rather than by one
         // thread before the tiles.
         const TileRect r = tileRect(st.ctx.grid, tile);
+        // One 16-byte texel per pixel, from a local (the scene's colour, read through the
+        // frame's float pointer, would be loaded again for every store).
+        const float background[4] = {scene.background.r, scene.background.g, scene.background.b,
+                                     1.0f};
         for (uint32_t y = r.y0; y < r.y1; ++y) {
             const size_t i = size_t(y) * view.width + r.x0;
             float* c = out.color.data() + i * 4;
             for (uint32_t x = r.x0; x < r.x1; ++x, c += 4)
-                c[0] = scene.background.r, c[1] = scene.background.g, c[2] = scene.background.b,
-                c[3] = 1.0f;
+                std::memcpy(c, background, sizeof(background));
             out.depth.fill(i, r.x1 - r.x0, kFarDepth);
             if (transparency)
                 out.transparent_depth.fill(i, r.x1 - r.x0, kFarDepth);
