@@ -32,6 +32,7 @@ struct TriangleRaster {
     const size_t* lane_offset;
     // The lookups the material makes: base colour (0) and emissive (1; not when its factor is 0).
     bool textured[2];
+    const TextureRef* texture[2];
     // Both are made and the emissive one reads the base colour's coordinates and levels
     // (sameFootprint): its quad pairs are prepared once, the coordinates queued once.
     bool shared_lookup;
@@ -168,7 +169,6 @@ void shadeLanes(const RasterContext& ctx, TriangleRaster& tr, const FragmentLane
                 uint32_t lanes, Sink& sink, LightBatch& batch, TileCounters& counters) {
     const SetupTri& t = *tr.tri;
     const Material& m = *tr.material;
-    const TextureRef* refs[2] = {&m.base_color_texture, &m.emissive_texture};
     if (tr.shared_lookup) {
         TextureLanes& emissive = *f.texture[1];
         std::copy_n(f.texture[0]->u, kTextureLanes, emissive.u);
@@ -177,7 +177,7 @@ void shadeLanes(const RasterContext& ctx, TriangleRaster& tr, const FragmentLane
     }
     for (int k = 0; k < 2; ++k)
         if (tr.textured[k]) // the fragment kernel reads the emissive colour, not its alpha
-            sampleLanes(ctx.shade, *refs[k], *f.sel[k], lanes, k == 1, *f.texture[k]);
+            sampleLanes(ctx.shade, *tr.texture[k], *f.sel[k], lanes, k == 1, *f.texture[k]);
     const float(*base_texel)[kQuadLanes] = tr.textured[0] ? f.texture[0]->rgba : nullptr;
     const float(*emissive_texel)[kQuadLanes] = tr.textured[1] ? f.texture[1]->rgba : nullptr;
 
@@ -345,10 +345,9 @@ void queueQuadPair(const RasterContext& ctx, TriangleRaster& tr, int32_t qx, int
             pair_uv.u[l] = q.persp[0][l] * uv0.x + q.persp[1][l] * uv1.x + q.persp[2][l] * uv2.x;
             pair_uv.v[l] = q.persp[0][l] * uv0.y + q.persp[1][l] * uv1.y + q.persp[2][l] * uv2.y;
         }
-        const TextureRef* refs[2] = {&m.base_color_texture, &m.emissive_texture};
         for (int k = 0; k < 2; ++k)
             if (tr.textured[k] && !(k == 1 && tr.shared_lookup))
-                prepareQuadPair(ctx.shade, *refs[k], pair_uv, lookup[k]);
+                prepareQuadPair(ctx.shade, *tr.texture[k], pair_uv, lookup[k]);
     }
     // A full pair whose quads read the same levels is shaded where it is, without the copies
     // into the queue (after the queue's lanes, which come before it). Measured against pairs of
@@ -429,6 +428,8 @@ void rasterizeTriangle(const RasterContext& ctx, const GeometryChunk& chunk, con
     const Material& m = *tr.material;
     tr.textured[0] = m.base_color_texture.image >= 0;
     tr.textured[1] = m.emissive_texture.image >= 0 && m.emissive_factor != glm::vec3(0.0f);
+    tr.texture[0] = &m.base_color_texture;
+    tr.texture[1] = &m.emissive_texture;
     tr.shared_lookup = tr.textured[0] && tr.textured[1] &&
                        sameFootprint(*ctx.shade.scene, m.base_color_texture, m.emissive_texture);
     sink.beginTriangle(t, tr.material->alpha_mode == AlphaMode::Blend);
