@@ -255,8 +255,9 @@ TEST(Texture, LookupsOfZeroTexelsAreSkippedWithTheSameBits) {
 // Each 2x2 quad selects its mip level from its own derivatives, and the tile raster packs the
 // lanes of a triangle's quads for the texture kernel (tile_raster.cpp, FragmentQueue), so a lane
 // must be filtered on its own quad's levels even when the quads before it in the queue read
-// others. A plane tilted away from the eye, cut into small triangles (whose ends empty the
-// queue), with an image whose every level is one colour and nearest mip filtering: every pixel
+// others. A plane turned away from the eye, cut into small triangles (whose ends empty the
+// queue) or large ones (whose full pairs are shaded in place), with an image whose every level
+// is one colour and nearest mip filtering: every pixel
 // shows the level its quad's derivatives select, computed here from the plane's analytic
 // texture coordinates (quads within 0.01 of a level boundary are not judged).
 TEST(Texture, EachQuadReadsTheLevelOfItsOwnDerivatives) {
@@ -337,8 +338,8 @@ TEST(Texture, EachQuadReadsTheLevelOfItsOwnDerivatives) {
         const Hit h = hitAt(x, y);
         return glm::dvec2(su * h.a * kTexels, sv * h.b * kTexels);
     };
-    int judged = 0, levels_seen = 0;
-    uint32_t seen = 0;
+    int judged = 0;
+    uint32_t seen = 0; // bit k: a judged pixel read level k
     for (const uint32_t cells : {100u, 4u})
         for (const bool simd : {true, false}) {
             raster::RenderOptions o;
@@ -372,10 +373,9 @@ TEST(Texture, EachQuadReadsTheLevelOfItsOwnDerivatives) {
                         }
                 }
         }
-    levels_seen = std::popcount(seen);
-    EXPECT_GT(judged, 2 * 10000) << levels_seen;
-    std::printf("judged %d levels %d\n", judged, levels_seen);
-    EXPECT_GE(levels_seen, 4); // the plane spans several levels
+    // Four renders of 96 x 160 pixels: the plane covers most, few quads lie at a boundary.
+    EXPECT_GT(judged, 4 * 9000);
+    EXPECT_GE(std::popcount(seen), 4); // the plane spans several levels
 }
 
 // The tile raster prepares the emissive lookup from the base colour's when both read the same
