@@ -42,10 +42,10 @@ inline void storeLanes(int32_t* p, __m256i v) {
 // quarter of the kernel's instructions on demo, callgrind); integers, so the same values.
 inline void wrapLanes(const int32_t* i, int32_t n, Wrap mode, int32_t* w0, int32_t* w1) {
 #ifdef FOCAL_TEXTURE_KERNEL_AVX2
-    const __m256i vi = loadLanes(i), last = _mm256_set1_epi32(n - 1);
+    const __m256i vi = loadLanes(i);
     if (mode == Wrap::ClampToEdge) {
         // a < 0 ? 0 : min(a, n - 1) is max(0, min(a, n - 1)) for n >= 1.
-        const __m256i zero = _mm256_setzero_si256();
+        const __m256i zero = _mm256_setzero_si256(), last = _mm256_set1_epi32(n - 1);
         storeLanes(w0, _mm256_max_epi32(zero, _mm256_min_epi32(vi, last)));
         storeLanes(w1,
                    _mm256_max_epi32(
